@@ -1,0 +1,41 @@
+#pragma once
+/// \file
+/// Errors that reach the user. Every reader and algorithm reports bad user input with
+/// `InputError`, naming where the problem is (file, line, column or field) and what was expected.
+/// The command-line tool maps `InputError` to exit status 3.
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+
+namespace servotwin::core {
+
+/// Where a problem sits in user input. Empty/zero members are simply not printed.
+struct SourceLocation {
+  std::string file;        ///< file name as the user gave it (or a label such as "<stdin>")
+  std::size_t line = 0;    ///< 1-based line, 0 = unknown
+  std::size_t column = 0;  ///< 1-based column, 0 = unknown
+  std::string field;       ///< JSON field, CSV column or option name, empty = none
+};
+
+/// Formats a location as `file:line:column` followed by ` (field)` when a field is set.
+std::string to_string(const SourceLocation& where);
+
+/// Bad user input: malformed files, values out of range, inconsistent options.
+class InputError : public std::runtime_error {
+ public:
+  /// `message` says what is wrong and what was expected; it is prefixed with the location.
+  InputError(SourceLocation where, const std::string& message);
+  /// Error without a location (e.g. a problem with a combination of options).
+  explicit InputError(const std::string& message);
+
+  [[nodiscard]] const SourceLocation& where() const noexcept { return where_; }
+  /// The message without the location prefix.
+  [[nodiscard]] const std::string& reason() const noexcept { return reason_; }
+
+ private:
+  SourceLocation where_;
+  std::string reason_;
+};
+
+}  // namespace servotwin::core
