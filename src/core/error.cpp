@@ -2,20 +2,26 @@
 
 namespace servotwin::core {
 
+// Built with append() rather than operator+ chains: GCC 12 reports a false -Wrestrict on the
+// latter (GCC bug 105329).
 std::string to_string(const SourceLocation& where) {
   std::string out = where.file;
   if (where.line > 0) {
-    out += (out.empty() ? "line " : ":") + std::to_string(where.line);
-    if (where.column > 0) out += ":" + std::to_string(where.column);
+    out.append(out.empty() ? "line " : ":").append(std::to_string(where.line));
+    if (where.column > 0) out.append(":").append(std::to_string(where.column));
   }
-  if (!where.field.empty()) out += (out.empty() ? "" : " ") + std::string("(") + where.field + ")";
+  if (!where.field.empty()) {
+    if (!out.empty()) out.append(" ");
+    out.append("(").append(where.field).append(")");
+  }
   return out;
 }
 
 namespace {
 std::string compose(const SourceLocation& where, const std::string& message) {
-  const std::string prefix = to_string(where);
-  return prefix.empty() ? message : prefix + ": " + message;
+  std::string out = to_string(where);
+  if (!out.empty()) out.append(": ");
+  return out.append(message);
 }
 }  // namespace
 

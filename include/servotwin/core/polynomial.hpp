@@ -11,6 +11,10 @@
 namespace servotwin::core {
 
 /// Real polynomial p(x) = c[0] x^n + c[1] x^(n-1) + ... + c[n].
+///
+/// Errors: core is called with values that readers have validated, so bad arguments here are
+/// programming errors and throw std::invalid_argument (readers report bad file content as
+/// core::InputError before it gets here).
 class Polynomial {
  public:
   /// The zero polynomial.
@@ -20,7 +24,9 @@ class Polynomial {
   Polynomial(std::initializer_list<double> coefficients_descending);
 
   /// Monic-times-gain polynomial with the given roots. Complex roots must come in conjugate
-  /// pairs (within a relative 1e-9); the imaginary parts of the product are discarded.
+  /// pairs (within a relative 1e-9); each pair becomes the real quadratic factor of its mean, and a
+  /// root whose imaginary part is below 1e-9 of its modulus counts as real. Throws
+  /// std::invalid_argument for an unpaired complex root or a non-finite root.
   static Polynomial from_roots(std::span<const std::complex<double>> roots, double gain = 1.0);
 
   /// Degree; the zero polynomial has degree -1.
@@ -32,15 +38,28 @@ class Polynomial {
   [[nodiscard]] double coefficient_of_power(int k) const noexcept;
   [[nodiscard]] double leading() const noexcept { return c_.empty() ? 0.0 : c_.front(); }
 
-  /// Horner evaluation.
+  /// Horner evaluation (0 for the zero polynomial).
   [[nodiscard]] double operator()(double x) const noexcept;
   [[nodiscard]] std::complex<double> operator()(std::complex<double> x) const noexcept;
 
   [[nodiscard]] Polynomial derivative() const;
 
   /// All roots (with multiplicity): eigenvalues of the balanced companion matrix, each polished
-  /// by Newton steps on the original polynomial while that reduces |p(root)|. Complex roots come
-  /// out as exact conjugate pairs. Zero roots (trailing zero coefficients) are exact.
+  /// by Newton steps on the original polynomial while that reduces |p(root)| and |p| is above the
+  /// rounding level of its evaluation. Complex roots come out as exact conjugate pairs and real
+  /// eigenvalues as exactly real roots. Zero roots (trailing zero coefficients) are exact.
+  ///
+  /// Multiple roots: the eigenvalues of an m-fold root scatter on a circle of radius
+  /// ~eps^(1/m). A tight, well-separated cluster of m roots is replaced by m copies of its centre
+  /// (refined as a simple root of p^(m-1)) when p, p', ..., p^(m-1) all vanish there to rounding
+  /// accuracy, i.e. when p is within rounding of a polynomial with that m-fold root; e.g. the roots
+  /// of (s+1)^3 (s+2) come out as -1, -1, -1, -2 to ~1e-15 instead of numpy's ~1e-5.
+  ///
+  /// Order: ascending modulus, then ascending real part, then positive imaginary part first (so a
+  /// conjugate pair is adjacent, upper member first). Degree 0 and the zero polynomial have no
+  /// roots. Throws std::invalid_argument for non-finite coefficients or when a root modulus lies
+  /// beyond the double range (e.g. 1e-320 s^2 + s + 1 has a root at -1e320), and
+  /// std::runtime_error in the (not observed) case that the eigenvalue iteration fails.
   [[nodiscard]] std::vector<std::complex<double>> roots() const;
 
   friend Polynomial operator+(const Polynomial& a, const Polynomial& b);
