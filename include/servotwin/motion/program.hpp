@@ -44,15 +44,21 @@ struct Block {
   BlockType type = BlockType::None;
   Point start{};               ///< position before the block [mm]
   Point end{};                 ///< position after the block [mm]
-  Point center{};              ///< arc centre [mm]; the coordinate along the plane normal is unused
+  Point center{};              ///< arc centre [mm]; along the plane normal it holds start's value
+  /// Plane of arcs; for other blocks the active plane (ISO G17/G18/G19, Heidenhain TOOL CALL axis).
   Plane plane = Plane::XY;
-  double feed_mm_min = 0.0;    ///< programmed (modal) feed for Linear and arcs; ignored for Rapid
+  /// Programmed (modal) feed for Linear and arcs; for Rapid the modal feed at that point (ignored
+  /// when moving); 0 for Dwell and None blocks.
+  double feed_mm_min = 0.0;
   double dwell_s = 0.0;        ///< Dwell only
   std::uint8_t axes = 0;       ///< mask of axes written in this block (axis_bit)
   std::vector<int> m_codes;    ///< M codes of the line, kept, not interpreted
   std::size_t line = 0;        ///< 1-based source line (0 for generated blocks)
   long number = -1;            ///< N number / Heidenhain block number, -1 when absent
-  std::string comment;         ///< comment text of the line, if any (without delimiters)
+  std::string comment;         ///< comment text of the line, if any (without delimiters, trimmed)
+  /// None blocks only: a dialect statement without motion, kept for rewriting in canonical form
+  /// with lengths in mm (Heidenhain `BLK FORM 0.1 Z Y-50.000 Z-50.000`, `TOOL CALL 0 Z`).
+  std::string statement;
 };
 
 /// A reader's warning (only in lenient mode), tied to a line and column.
