@@ -23,9 +23,11 @@ struct RigidPlant {
   double gain = 0.0;     ///< K > 0, control signal -> force
 };
 
-/// Asymmetric Coulomb friction with stiction. Forces oppose motion: `coulomb_pos` (>= 0) acts
+/// Asymmetric Coulomb friction with stiction [N]. Forces oppose motion: `coulomb_pos` (>= 0) acts
 /// while moving in +, `coulomb_neg` (<= 0) while moving in -. At rest the axis sticks while
-/// static_neg <= K u <= static_pos. Stiction levels default to the Coulomb levels.
+/// static_neg <= K u <= static_pos. Stiction levels default to the Coulomb levels and must not
+/// be inside them (static_pos >= coulomb_pos, static_neg <= coulomb_neg). In Eq. 3.3 terms
+/// d0 = coulomb_pos / J and d1 = coulomb_neg / J.
 struct Friction {
   double coulomb_pos = 0.0;
   double coulomb_neg = 0.0;
@@ -36,7 +38,9 @@ struct Friction {
 /// Where the position feedback is taken when the axis has backlash.
 enum class Feedback { Motor, Table };
 
-/// Lost motion (play) of width `width` [mm] between the driven motor side and the table.
+/// Lost motion (play) of width `width` [mm] between the driven motor side and the table: a play
+/// operator, the table (massless, carried by the rigid plant's inertia) stays put until the motor
+/// side is width/2 away and is then dragged along. Both start centred at `home`.
 struct Backlash {
   double width = 0.0;
   Feedback feedback = Feedback::Motor;
@@ -53,6 +57,21 @@ struct Nonlinearities {
   double encoder_noise_std = 0.0;   ///< white measurement noise [mm]
   int delay_samples = 0;       ///< computation delay: u computed at k is applied at k + delay (0 or 1)
 };
+// Signal chain per sample k: the encoder reads the feedback position (motor or table side),
+// adds white noise and quantizes (y = q round((x + n)/q)); the controller computes u(k);
+// saturation clips it to +-u_max; the DAC rounds it to its 2^bits codes over +-dac_range
+// (two's complement, [-range, range - LSB]); the delay line holds it for delay_samples; the
+// plant integrates the held value exactly over [k ts, (k+1) ts).
+
+/// How every discrete controller below is sampled (period ts, sample k):
+///  * command derivatives (feedforward and the reference side of derivative terms) are central
+///    differences with one sample of look-ahead, x_r'(k) = (x_r(k+1) - x_r(k-1)) / (2 ts),
+///    x_r''(k) = (x_r(k+1) - 2 x_r(k) + x_r(k-1)) / ts^2 (the interpolator has the next sample);
+///  * the measured velocity is the backward difference of the position reading,
+///    x'(k) = (y(k) - y(k-1)) / ts;
+///  * integrators are backward Euler, I(k) = I(k-1) + ts e(k): the integral includes the current
+///    error (no extra sample of lag), as the thesis's integrated tracking error e_i,k does;
+///  * there is no anti-windup (the thesis's identification experiments avoid saturation).
 
 /// P-PI cascade: velocity command v_c = kp (x_r - x) + vel_ff x_r';
 /// u = kv (v_c - x') + ki * integral(v_c - x') + acc_ff x_r''.
@@ -88,15 +107,25 @@ struct SlidingModeController {
 
 /// Discrete pole placement with a Kalman-filter disturbance observer and, optionally, a zero
 /// phase error tracking controller (ZPETC, Tomizuka 1987) as feedforward (thesis section 3.4.2).
-/// The closed-loop poles of the state feedback are placed at the z-images of a continuous pair
-/// with frequency `wn_hz` and damping `zeta`; the ZPETC cancels them and the plant's well-damped
-/// zeros and removes the phase of the zero near -1, using `preview` samples of the command.
+/// Designed in discrete time from the zero-order-hold model of the rigid plant (including the
+/// axis's computation delay, whose extra poles are placed at z = 0): state feedback on [x, v]
+/// places the z-images exp(s ts) of the continuous pair with frequency `wn_hz` and damping
+/// `zeta`; a steady-state Kalman filter (current-estimator form) estimates [x, v, d] with a
+/// random-walk disturbance d (an acceleration, like Eq. 3.3's d0, d1); the control is
+/// u = N x_r* - L x_hat + (J/K) d_hat with N for unit DC gain. The ZPETC
+/// x_r*/x_r = A(z) B-(1/z) / (B+ B-(1)^2) cancels the closed-loop poles and removes the phase
+/// of the plant's zero near -1, using 2 + delay samples of command preview
+/// (see pole_placement.hpp).
 struct PolePlacementController {
   double wn_hz = 30.0;
   double zeta = 0.7;
   bool zpetc = true;
-  double kalman_process_noise = 1.0;      ///< disturbance random-walk intensity (relative)
-  double kalman_measurement_noise = 1e-6; ///< encoder noise variance (relative)
+  /// Spectral density W of the disturbance random walk [(mm/s^2)^2/s]: per sample the
+  /// disturbance changes with variance W ts. Default: 1000 mm/s^2 per sample at ts = 1 ms.
+  double kalman_process_noise = 1e9;
+  /// Variance of the position measurement [mm^2]. Default: (1 um)^2. Only the ratio of the two
+  /// intensities matters, and it does not depend on the length unit.
+  double kalman_measurement_noise = 1e-6;
 };
 
 using Controller = std::variant<PPiController, PidController, SlidingModeController, PolePlacementController>;
@@ -116,6 +145,9 @@ struct CncSettings {
   std::optional<double> jerk;       ///< [mm/s^3], empty = trapezoidal
   double rapid_feed_mm_min = 15000;
   double corner_angle_deg = 1.0;
+  /// Stop exactly at the end of every block (G61), as CNCs without look-ahead do; the thesis's
+  /// 22 s identification capture (Table 3.2 program) implies it.
+  bool exact_stop_every_block = false;
 };
 
 /// A machine: axes sampled together at ts.
@@ -129,8 +161,12 @@ struct MachineConfig {
   [[nodiscard]] const AxisConfig* find(const std::string& axis_name) const noexcept;
 };
 
-/// Checks every value (positive inertia and gain, finite gains, ts > 0, unique axis names, ...)
-/// and throws core::InputError with field = the offending member ("axes[0].plant.inertia").
+/// Checks every value (positive inertia and gain, finite gains, ts > 0, unique lower-case axis
+/// names, friction signs, ...) and throws core::InputError with field = the offending member
+/// ("axes[0].plant.inertia"). Also rejects an axis whose linear sampled closed loop (plant plus
+/// discrete controller plus delay) is unstable at ts, with field "axes[i].controller".
 void validate(const MachineConfig& machine);
+/// Checks one axis; `prefix` is prepended to field names (e.g. "axes[0]").
+void validate(const AxisConfig& axis, double ts, const std::string& prefix);
 
 }  // namespace servotwin::machine
