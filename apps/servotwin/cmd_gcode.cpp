@@ -1,0 +1,184 @@
+// `servotwin gcode`: identification-program generator, program check and dialect conversion.
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "command.hpp"
+#include "servotwin/core/error.hpp"
+#include "servotwin/io/program_file.hpp"
+#include "servotwin/motion/gcode.hpp"
+#include "servotwin/motion/identification_program.hpp"
+
+namespace servotwin::cli {
+
+namespace {
+
+const std::map<std::string, motion::Dialect> kDialects{{"iso", motion::Dialect::Iso},
+                                                       {"heidenhain", motion::Dialect::Heidenhain}};
+
+struct IdentificationArgs {
+  std::vector<std::string> axes{"X"};
+  std::string speed = "standard";
+  std::size_t moves = 0;
+  double range = 0.0, feed = 0.0;
+  std::vector<double> center;
+  std::uint64_t seed = 1;
+  motion::Dialect dialect = motion::Dialect::Iso;
+  std::string name = "RAPIDIDENT";
+  std::string output = "-";
+  CLI::Option *moves_opt = nullptr, *range_opt = nullptr, *feed_opt = nullptr;
+};
+
+std::string render(const motion::Program& program, motion::Dialect dialect) {
+  return dialect == motion::Dialect::Iso ? motion::write_iso(program) : motion::write_heidenhain(program);
+}
+
+int run_identification(const IdentificationArgs& a, const GlobalOptions& global) {
+  const std::map<std::string, motion::IdentificationSet> sets{{"standard", motion::IdentificationSet::Standard},
+                                                              {"low", motion::IdentificationSet::Low},
+                                                              {"high", motion::IdentificationSet::High}};
+  motion::IdentificationOptions o = motion::identification_defaults(sets.at(a.speed));
+  o.axes = parse_axes(a.axes, "--axis");
+  if (a.moves_opt->count() > 0) o.moves = a.moves;
+  if (a.range_opt->count() > 0) o.range_mm = a.range;
+  if (a.feed_opt->count() > 0) o.feed_mm_min = a.feed;
+  if (!a.center.empty()) {
+    if (a.center.size() != o.axes.size())
+      throw core::InputError({"", 0, 0, "--center"}, "give one centre per axis (" + std::to_string(o.axes.size()) +
+                                                         "), got " + std::to_string(a.center.size()));
+    for (std::size_t i = 0; i < o.axes.size(); ++i) o.center[static_cast<std::size_t>(o.axes[i])] = a.center[i];
+  }
+  o.seed = a.seed;
+  o.name = a.name;
+  o.dialect = a.dialect;
+  const motion::Program program = motion::make_identification_program(o);
+  auto out = open_output(a.output, global);
+  out->stream() << motion::write_program(program);
+  out->commit();
+  progress(global, "wrote {} ({} moves, +-{} mm, F{}, seed {})", a.output == "-" ? "program to stdout" : a.output,
+           o.moves, o.range_mm, o.feed_mm_min, o.seed);
+  return kSuccess;
+}
+
+struct ProgramArgs {
+  std::string program;
+  std::string dialect = "auto";
+  bool lenient = false;
+  std::string to = "iso";
+  std::string output = "-";
+};
+
+motion::Program load(const ProgramArgs& a) {
+  motion::ParseOptions options;
+  options.lenient = a.lenient;
+  std::optional<motion::Dialect> dialect;
+  if (a.dialect != "auto") dialect = kDialects.at(a.dialect);
+  return io::read_program_file(a.program, options, dialect);
+}
+
+void print_warnings(const motion::Program& program, const std::string& source) {
+  for (const auto& w : program.warnings)
+    fmt::print(stderr, "{}:{}:{}: warning: {}\n", source, w.line, w.column, w.message);
+}
+
+int run_check(const ProgramArgs& a, const GlobalOptions& /*global*/) {
+  const motion::Program program = load(a);
+  print_warnings(program, a.program);
+  std::map<motion::BlockType, std::size_t> counts;
+  double path_mm = 0.0;
+  motion::Point lo = program.start, hi = program.start;
+  for (const auto& b : program.blocks) {
+    ++counts[b.type];
+    if (b.type == motion::BlockType::Rapid || b.type == motion::BlockType::Linear) {
+      double d2 = 0.0;
+      for (std::size_t i = 0; i < motion::kAxisCount; ++i) d2 += (b.end[i] - b.start[i]) * (b.end[i] - b.start[i]);
+      path_mm += std::sqrt(d2);
+    }
+    for (std::size_t i = 0; i < motion::kAxisCount; ++i) {
+      lo[i] = std::min(lo[i], b.end[i]);
+      hi[i] = std::max(hi[i], b.end[i]);
+    }
+  }
+  fmt::print("{}: {} program, {} blocks: {} rapid, {} linear, {} arcs, {} dwells\n", a.program,
+             program.dialect == motion::Dialect::Iso ? "ISO" : "Heidenhain", program.blocks.size(),
+             counts[motion::BlockType::Rapid], counts[motion::BlockType::Linear],
+             counts[motion::BlockType::ArcCw] + counts[motion::BlockType::ArcCcw], counts[motion::BlockType::Dwell]);
+  const std::uint8_t used = program.used_axes();
+  for (std::size_t i = 0; i < motion::kAxisCount; ++i) {
+    const auto axis = static_cast<motion::Axis>(i);
+    if (used & motion::axis_bit(axis))
+      fmt::print("  {}: {:.4f} .. {:.4f} mm\n", motion::axis_letter(axis), lo[i], hi[i]);
+  }
+  fmt::print("  straight-line path length: {:.3f} mm; {} warning(s)\n", path_mm, program.warnings.size());
+  return kSuccess;
+}
+
+int run_convert(const ProgramArgs& a, const GlobalOptions& global) {
+  const motion::Program program = load(a);
+  print_warnings(program, a.program);
+  auto out = open_output(a.output, global);
+  out->stream() << render(program, kDialects.at(a.to));
+  out->commit();
+  return kSuccess;
+}
+
+void add_program_options(CLI::App& cmd, ProgramArgs& a) {
+  cmd.add_option("program", a.program, "Part program (ISO G-code or Heidenhain conversational)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd.add_option("--dialect", a.dialect, "Dialect of the input: auto, iso or heidenhain")
+      ->check(CLI::IsMember({"auto", "iso", "heidenhain"}))
+      ->capture_default_str();
+  cmd.add_flag("--lenient", a.lenient, "Report unknown words as warnings instead of errors");
+}
+
+}  // namespace
+
+void register_gcode(CLI::App& app, Action& selected) {
+  CLI::App* gcode = app.add_subcommand("gcode", "Generate, check and convert part programs");
+  gcode->require_subcommand(1);
+
+  auto id = std::make_shared<IdentificationArgs>();
+  CLI::App* gen = gcode->add_subcommand(
+      "identification", "Write a rapid-identification program: random moves within +-range (thesis Tables 3.2, 4.3, 4.4)");
+  gen->add_option("--axis", id->axes, "Axes moved together, e.g. X, Y or XY (repeatable)")->capture_default_str();
+  gen->add_option("--speed", id->speed,
+                  "Program kind: standard (Table 3.2: 200 moves, +-10 mm, F12000), low (Table 4.3: moves of tens "
+                  "of um, F15000) or high (Table 4.4: sweeps and moves up to +-10 mm, F15000)")
+      ->check(CLI::IsMember({"standard", "low", "high"}))
+      ->capture_default_str();
+  id->moves_opt = gen->add_option("--moves", id->moves, "Number of random moves (default from --speed)")
+                      ->check(CLI::PositiveNumber);
+  id->range_opt = gen->add_option("--range", id->range, "Half-width of the motion range around the centre [mm]");
+  id->feed_opt = gen->add_option("--feed", id->feed, "Programmed feed [mm/min]");
+  gen->add_option("--center", id->center, "Centre of the motion range [mm], one value per axis");
+  gen->add_option("--seed", id->seed, "Random seed: the same seed gives the same program")->capture_default_str();
+  gen->add_option("--dialect", id->dialect, "Output dialect: iso or heidenhain")
+      ->transform(CLI::CheckedTransformer(kDialects, CLI::ignore_case))
+      ->capture_default_str();
+  gen->add_option("--name", id->name, "Program name (Heidenhain BEGIN PGM)")->capture_default_str();
+  gen->add_option("-o,--output", id->output, "Output file, - for standard output")->capture_default_str();
+  set_examples(*gen,
+               "  servotwin gcode identification --axis X --moves 200 --range 10 --feed 12000 --seed 7 -o id.nc\n"
+               "  servotwin gcode identification --axis X --dialect heidenhain --speed low --seed 7 -o low.h\n"
+               "  servotwin gcode identification --axis XY --speed high --dialect heidenhain -o high.h\n");
+  gen->callback([id, &selected] { selected = [id](const GlobalOptions& g) { return run_identification(*id, g); }; });
+
+  auto check = std::make_shared<ProgramArgs>();
+  CLI::App* chk = gcode->add_subcommand("check", "Read a program and print a summary (errors: exit status 3)");
+  add_program_options(*chk, *check);
+  set_examples(*chk, "  servotwin gcode check id.nc\n  servotwin gcode check part.h --lenient\n");
+  chk->callback([check, &selected] { selected = [check](const GlobalOptions& g) { return run_check(*check, g); }; });
+
+  auto conv = std::make_shared<ProgramArgs>();
+  CLI::App* cvt = gcode->add_subcommand("convert", "Rewrite a program in the other dialect");
+  add_program_options(*cvt, *conv);
+  cvt->add_option("--to", conv->to, "Output dialect: iso or heidenhain")
+      ->check(CLI::IsMember({"iso", "heidenhain"}))
+      ->capture_default_str();
+  cvt->add_option("-o,--output", conv->output, "Output file, - for standard output")->capture_default_str();
+  set_examples(*cvt, "  servotwin gcode convert low.h --to iso -o low.nc\n");
+  cvt->callback([conv, &selected] { selected = [conv](const GlobalOptions& g) { return run_convert(*conv, g); }; });
+}
+
+}  // namespace servotwin::cli

@@ -1,0 +1,40 @@
+#include "command.hpp"
+
+#include <cctype>
+
+#include "servotwin/core/error.hpp"
+
+namespace servotwin::cli {
+
+std::unique_ptr<io::OutputFile> open_output(const std::string& path, const GlobalOptions& global) {
+  return std::make_unique<io::OutputFile>(path, global.force ? io::Overwrite::Allow : io::Overwrite::Refuse);
+}
+
+std::vector<motion::Axis> parse_axes(const std::vector<std::string>& values, const std::string& option) {
+  std::vector<motion::Axis> axes;
+  for (const auto& value : values) {
+    for (char c : value) {
+      if (c == ',' || c == ' ') continue;
+      motion::Axis axis{};
+      switch (std::toupper(static_cast<unsigned char>(c))) {
+        case 'X': axis = motion::Axis::X; break;
+        case 'Y': axis = motion::Axis::Y; break;
+        case 'Z': axis = motion::Axis::Z; break;
+        default:
+          throw core::InputError({"", 0, 0, option}, "unknown axis '" + std::string(1, c) + "' (expected X, Y or Z)");
+      }
+      for (motion::Axis a : axes)
+        if (a == axis) throw core::InputError({"", 0, 0, option}, "axis " + std::string(1, motion::axis_letter(axis)) + " given twice");
+      axes.push_back(axis);
+    }
+  }
+  return axes;
+}
+
+void set_examples(CLI::App& command, const std::string& examples) { command.footer("\nExamples:\n" + examples); }
+
+double elapsed_ms(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace servotwin::cli

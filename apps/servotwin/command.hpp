@@ -1,0 +1,59 @@
+#pragma once
+// Shared pieces of the command-line tool: how subcommands register, global options, output files,
+// progress messages and exit codes.
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "servotwin/io/output_file.hpp"
+#include "servotwin/motion/program.hpp"
+
+namespace servotwin::cli {
+
+/// Exit statuses (README "Command line").
+enum ExitStatus : int { kSuccess = 0, kInternalError = 1, kUsageError = 2, kBadInput = 3 };
+
+/// Options every subcommand understands.
+struct GlobalOptions {
+  bool quiet = false;  ///< no progress messages on stderr
+  bool force = false;  ///< allow replacing existing output files
+};
+
+/// The action a subcommand runs after parsing; returns the exit status.
+using Action = std::function<int(const GlobalOptions&)>;
+
+/// A subcommand adds itself to `app` and stores its action in `selected` when it is chosen.
+using Registrar = void (*)(CLI::App& app, Action& selected);
+
+void register_gcode(CLI::App& app, Action& selected);
+void register_interpolate(CLI::App& app, Action& selected);
+void register_capture(CLI::App& app, Action& selected);
+void register_machine(CLI::App& app, Action& selected);
+void register_demo(CLI::App& app, Action& selected);
+
+/// Progress line on stderr (suppressed by --quiet).
+template <typename... Args>
+void progress(const GlobalOptions& global, fmt::format_string<Args...> format, Args&&... args) {
+  if (global.quiet) return;
+  fmt::print(stderr, "servotwin: ");
+  fmt::print(stderr, format, std::forward<Args>(args)...);
+  fmt::print(stderr, "\n");
+}
+
+/// Opens an output file honouring --force; "-" writes to stdout.
+std::unique_ptr<io::OutputFile> open_output(const std::string& path, const GlobalOptions& global);
+
+/// Parses axis lists such as "X", "xy", "X,Y" (repeatable option values) into axes.
+std::vector<motion::Axis> parse_axes(const std::vector<std::string>& values, const std::string& option);
+
+/// Adds the "Examples:" footer shown by --help.
+void set_examples(CLI::App& command, const std::string& examples);
+
+/// Milliseconds elapsed since `start` (steady clock, for progress messages).
+double elapsed_ms(std::chrono::steady_clock::time_point start);
+
+}  // namespace servotwin::cli

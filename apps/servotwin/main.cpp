@@ -1,0 +1,52 @@
+// servotwin command-line tool: dispatches to one subcommand per source file and maps errors to
+// exit statuses (0 success, 2 usage error, 3 bad input, 1 internal error).
+#include <cstdio>
+#include <exception>
+
+#include "command.hpp"
+#include "servotwin/core/error.hpp"
+
+int main(int argc, char** argv) {
+  using namespace servotwin::cli;
+  CLI::App app{"servotwin - digital twins of machine axes: identification programs, interpolation, "
+               "virtual machine tools and captures.",
+               "servotwin"};
+  app.require_subcommand(1);
+  app.fallthrough();  // global flags (-q, -f) may follow the subcommand
+  app.set_version_flag("--version", "servotwin 0.1.0");
+  GlobalOptions global;
+  app.add_flag("-q,--quiet", global.quiet, "No progress messages on stderr");
+  app.add_flag("-f,--force", global.force, "Overwrite existing output files");
+  app.footer(
+      "\nRun 'servotwin <command> --help' for the options and examples of a command.\n"
+      "Exit status: 0 success, 2 usage error, 3 bad input (file, value), 1 internal error.");
+
+  Action selected;
+  for (Registrar add : {register_gcode, register_interpolate, register_capture, register_machine, register_demo})
+    add(app, selected);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kUsageError;
+  }
+  try {
+    return selected ? selected(global) : kUsageError;
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "servotwin: error: %s\n", e.what());
+    return kUsageError;
+  } catch (const servotwin::core::InputError& e) {
+    std::fprintf(stderr, "servotwin: error: %s\n", e.what());
+    return kBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "servotwin: internal error: %s\n", e.what());
+    return kInternalError;
+  }
+}

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# One command for developers and CI: install what is missing, build everything (Release, warnings
+# as errors) and run every test with CTest, then the same with address+undefined sanitizers.
+# `--quick` skips the sanitizer pass.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+asan=1
+for arg in "$@"; do
+  case "$arg" in
+    --quick) asan=0 ;;
+    *) echo "test.sh: unknown option $arg" >&2; exit 2 ;;
+  esac
+done
+scripts/install-deps.sh --test
+
+run_preset() {
+  local preset=$1
+  echo "== configure and build ($preset)"
+  cmake --preset "$preset" -DSERVOTWIN_BUILD_TESTS=ON >/dev/null
+  cmake --build --preset "$preset"
+  echo "== test ($preset)"
+  ctest --preset "$preset" 2>&1 | tee "build/$preset/ctest.log" | grep -vE "^ +Start|^ *[0-9]+/[0-9]+ Test +#[0-9]+: .* Passed" || true
+  # ctest's summary (the lines after the per-test list) decides the exit status.
+  grep -q "100% tests passed" "build/$preset/ctest.log"
+}
+
+run_preset release
+if [ "$asan" -eq 1 ]; then
+  run_preset asan
+fi

@@ -1,0 +1,283 @@
+#include "servotwin/io/capture_csv.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fmt/format.h>
+#include <fstream>
+#include <istream>
+#include <ostream>
+#include <stdexcept>
+
+#include "csv_lines.hpp"
+#include "number_format.hpp"
+
+namespace servotwin::io {
+
+namespace {
+
+using detail::Field;
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return out;
+}
+
+bool ends_with(std::string_view s, std::string_view suffix) {
+  return s.size() > suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
+}
+
+/// Maps our column names to the file's columns.
+class ColumnResolver {
+ public:
+  ColumnResolver(const std::vector<Field>& header, const CaptureReadOptions& options, std::string_view source)
+      : options_(options), source_(source) {
+    for (const Field& f : header) names_.emplace_back(f.text);
+    for (const auto& [ours, theirs] : options.map) {
+      if (std::find(names_.begin(), names_.end(), theirs) == names_.end())
+        throw core::InputError({std::string(source), 1, 0, "--map " + ours + "=" + theirs},
+                               "the file has no column '" + theirs + "' (columns: " + column_list() + ")");
+    }
+  }
+
+  /// Index of our column `name` in the file, or npos.
+  [[nodiscard]] std::size_t find(const std::string& name) const {
+    std::string wanted = name;
+    for (const auto& [ours, theirs] : options_.map)
+      if (lower(ours) == name) wanted = theirs;
+    std::size_t found = std::string::npos;
+    for (std::size_t i = 0; i < names_.size(); ++i) {
+      if (names_[i] != wanted) continue;
+      if (found != std::string::npos)
+        throw core::InputError({std::string(source_), 1, 0, wanted}, "column '" + wanted + "' appears twice in the header");
+      found = i;
+    }
+    return found;
+  }
+
+  [[nodiscard]] std::size_t require(const std::string& name) const {
+    const std::size_t i = find(name);
+    if (i == std::string::npos)
+      throw core::InputError({std::string(source_), 1, 0, name},
+                             "missing column '" + name + "' (columns: " + column_list() + "); map one with --map " +
+                                 name + "=<column>");
+    return i;
+  }
+
+  /// Axis names with a `_cmd` or `_act` column (our names, after mapping), in file order.
+  [[nodiscard]] std::vector<std::string> discover_axes() const {
+    std::vector<std::string> ours;
+    for (const auto& n : names_) ours.push_back(lower(n));
+    for (const auto& [our_name, theirs] : options_.map) ours.push_back(lower(our_name));
+    std::vector<std::string> axes;
+    for (const auto& n : ours) {
+      for (std::string_view suffix : {"_cmd", "_act"}) {
+        if (!ends_with(n, suffix)) continue;
+        std::string axis = n.substr(0, n.size() - suffix.size());
+        if (std::find(axes.begin(), axes.end(), axis) == axes.end()) axes.push_back(axis);
+      }
+    }
+    return axes;
+  }
+
+  [[nodiscard]] std::string column_list() const {
+    std::string out;
+    for (const auto& n : names_) out += (out.empty() ? "" : ", ") + n;
+    return out.empty() ? "none" : out;
+  }
+
+ private:
+  const CaptureReadOptions& options_;
+  std::string_view source_;
+  std::vector<std::string> names_;
+};
+
+/// Where each data row came from, stored compactly: rows are consecutive lines except after
+/// skipped (comment/blank) lines, so only the jumps are kept.
+class RowLines {
+ public:
+  void add(std::size_t row, std::size_t line) {
+    if (jumps_.empty() || line_of(row) != line) jumps_.emplace_back(row, line);
+  }
+  [[nodiscard]] std::size_t line_of(std::size_t row) const {
+    if (jumps_.empty()) return 0;
+    auto it = std::upper_bound(jumps_.begin(), jumps_.end(), row,
+                               [](std::size_t r, const auto& jump) { return r < jump.first; });
+    if (it == jumps_.begin()) return 0;
+    --it;
+    return it->second + (row - it->first);
+  }
+
+ private:
+  std::vector<std::pair<std::size_t, std::size_t>> jumps_;
+};
+
+struct ColumnSink {
+  std::size_t index;
+  std::string name;      // our name, for messages
+  std::vector<double>* target;
+  double scale;
+};
+
+void check_time_grid(const std::vector<double>& t, const RowLines& lines, double max_jitter, std::string_view source,
+                     const std::string& column, double& t0, double& ts) {
+  const std::size_t n = t.size();
+  t0 = t.front();
+  ts = (t.back() - t.front()) / static_cast<double>(n - 1);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double deviation = std::abs(t[k] - (t0 + static_cast<double>(k) * ts));
+    if (deviation > max_jitter * ts)
+      throw core::InputError({std::string(source), lines.line_of(k), 0, column},
+                             fmt::format("time {} is {:.3g} % of the sample period ({} s) off the uniform grid; at "
+                                         "most {:.3g} % jitter is accepted (resample the file first)",
+                                         t[k], 100.0 * deviation / ts, ts, 100.0 * max_jitter));
+  }
+}
+
+void validate_options(const CaptureReadOptions& options, std::string_view source) {
+  if (!std::isfinite(options.scale) || options.scale == 0.0)
+    throw core::InputError({std::string(source), 0, 0, "--scale"}, "scale must be a finite non-zero number");
+  if (!(options.max_jitter >= 0.0 && options.max_jitter < 0.5))
+    throw core::InputError({std::string(source), 0, 0, "max_jitter"}, "jitter tolerance must be in [0, 0.5)");
+  if (options.ts && !(std::isfinite(*options.ts) && *options.ts > 0.0))
+    throw core::InputError({std::string(source), 0, 0, "--ts"}, "sample period must be > 0");
+}
+
+}  // namespace
+
+std::pair<std::string, std::string> parse_column_mapping(std::string_view text) {
+  const std::size_t eq = text.find('=');
+  if (eq == std::string_view::npos || eq == 0 || eq + 1 == text.size())
+    throw core::InputError({"", 0, 0, "--map"}, "expected <name>=<column>, e.g. x_cmd=qg, got '" + std::string(text) + "'");
+  return {lower(text.substr(0, eq)), std::string(text.substr(eq + 1))};
+}
+
+core::Capture read_capture_csv(std::istream& in, std::string_view source_name, const CaptureReadOptions& options) {
+  validate_options(options, source_name);
+  const std::string source(source_name);
+  std::string line;
+  std::size_t line_number = 0;
+  std::vector<Field> fields;
+
+  // Header: first line that is neither blank nor a comment.
+  bool have_header = false;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line_number == 1 && line.size() >= 3 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
+    if (detail::is_skippable_line(line)) continue;
+    have_header = true;
+    break;
+  }
+  if (!have_header) throw core::InputError({source, 0, 0, ""}, "empty file: expected a header row with column names");
+  const std::size_t header_line = line_number;
+  detail::split_csv_line(line, fields);
+  const std::size_t field_count = fields.size();
+  const ColumnResolver columns(fields, options, source);
+
+  core::Capture capture;
+  std::vector<std::string> axes = options.axes;
+  if (axes.empty()) axes = columns.discover_axes();
+  if (axes.empty())
+    throw core::InputError({source, header_line, 0, ""},
+                           "no axis columns: expected <axis>_cmd and <axis>_act (columns: " + columns.column_list() +
+                               "); map them with --map x_cmd=<column> --map x_act=<column>");
+  capture.axes.reserve(axes.size());
+  for (const auto& axis : axes) capture.axes.push_back(core::AxisTrace{lower(axis), {}, {}, {}});
+
+  std::vector<ColumnSink> sinks;
+  std::vector<double> time;
+  const std::size_t t_index = columns.find("t");
+  if (t_index != std::string::npos) sinks.push_back({t_index, "t", &time, 1.0});
+  else if (!options.ts)
+    throw core::InputError({source, header_line, 0, "t"},
+                           "missing time column 't' (columns: " + columns.column_list() +
+                               "); map one with --map t=<column> or give the sample period with --ts");
+  for (auto& trace : capture.axes) {
+    sinks.push_back({columns.require(trace.name + "_cmd"), trace.name + "_cmd", &trace.cmd, options.scale});
+    sinks.push_back({columns.require(trace.name + "_act"), trace.name + "_act", &trace.act, options.scale});
+    const std::size_t u = columns.find(trace.name + "_u");
+    if (u != std::string::npos) sinks.push_back({u, trace.name + "_u", &trace.u, 1.0});
+  }
+
+  RowLines row_lines;
+  std::size_t rows = 0;
+  double previous_t = 0.0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (detail::is_skippable_line(line)) continue;
+    detail::split_csv_line(line, fields);
+    if (fields.size() != field_count)
+      throw core::InputError({source, line_number, 0, ""},
+                             fmt::format("expected {} fields as in the header, found {}", field_count, fields.size()));
+    const core::SourceLocation where{source, line_number, 0, ""};
+    for (const ColumnSink& sink : sinks)
+      sink.target->push_back(detail::parse_number(fields[sink.index], where, sink.name) * sink.scale);
+    if (!time.empty()) {
+      const double t = time.back();
+      if (rows > 0 && !(t > previous_t))
+        throw core::InputError({source, line_number, fields[t_index].column, "t"},
+                               fmt::format("time does not increase: {} after {}", t, previous_t));
+      previous_t = t;
+    }
+    row_lines.add(rows, line_number);
+    ++rows;
+  }
+  if (in.bad()) throw core::InputError({source, line_number, 0, ""}, "read error");
+  if (rows < 2)
+    throw core::InputError({source, line_number, 0, ""},
+                           fmt::format("{} data row{}: a capture needs at least 2 samples", rows, rows == 1 ? "" : "s"));
+
+  if (!time.empty()) {
+    check_time_grid(time, row_lines, options.max_jitter, source, "t", capture.t0, capture.ts);
+    if (options.ts && std::abs(*options.ts - capture.ts) > options.max_jitter * capture.ts)
+      throw core::InputError({source, 0, 0, "--ts"},
+                             fmt::format("--ts {} disagrees with the file's time column (period {} s)", *options.ts,
+                                         capture.ts));
+  } else {
+    capture.t0 = 0.0;
+    capture.ts = *options.ts;
+  }
+  for (auto& trace : capture.axes) {
+    trace.cmd.shrink_to_fit();
+    trace.act.shrink_to_fit();
+    trace.u.shrink_to_fit();
+  }
+  return capture;
+}
+
+core::Capture read_capture_file(const std::string& path, const CaptureReadOptions& options) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError({path, 0, 0, ""}, "cannot open the file for reading");
+  return read_capture_csv(in, path, options);
+}
+
+void write_capture_csv(std::ostream& out, const core::Capture& capture) {
+  const std::size_t n = capture.size();
+  for (const auto& axis : capture.axes)
+    if (axis.cmd.size() != n || axis.act.size() != n || (!axis.u.empty() && axis.u.size() != n))
+      throw std::invalid_argument("write_capture_csv: traces of axis '" + axis.name + "' differ in length");
+  fmt::memory_buffer buffer;
+  buffer.append(std::string_view("t"));
+  for (const auto& axis : capture.axes) {
+    fmt::format_to(std::back_inserter(buffer), ",{0}_cmd,{0}_act", axis.name);
+    if (!axis.u.empty()) fmt::format_to(std::back_inserter(buffer), ",{}_u", axis.name);
+  }
+  buffer.push_back('\n');
+  const int time_decimals = detail::time_decimals(capture.t0, capture.ts);
+  for (std::size_t k = 0; k < n; ++k) {
+    detail::append_time(buffer, capture.time(k), time_decimals);
+    for (const auto& axis : capture.axes) {
+      fmt::format_to(std::back_inserter(buffer), ",{},{}", axis.cmd[k], axis.act[k]);
+      if (!axis.u.empty()) fmt::format_to(std::back_inserter(buffer), ",{}", axis.u[k]);
+    }
+    buffer.push_back('\n');
+    if (buffer.size() > (std::size_t{1} << 16)) {
+      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+      buffer.clear();
+    }
+  }
+  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+}
+
+}  // namespace servotwin::io

@@ -1,0 +1,78 @@
+#include "csv_lines.hpp"
+
+#include <charconv>
+#include <cmath>
+
+namespace servotwin::io::detail {
+
+namespace {
+bool is_blank(char c) noexcept { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+std::string_view trim(std::string_view s, std::size_t& offset) noexcept {
+  std::size_t b = 0;
+  while (b < s.size() && is_blank(s[b])) ++b;
+  std::size_t e = s.size();
+  while (e > b && is_blank(s[e - 1])) --e;
+  offset = b;
+  return s.substr(b, e - b);
+}
+
+std::string printable(std::string_view text) {
+  constexpr std::size_t kMaxShown = 40;
+  std::string out;
+  for (char c : text.substr(0, kMaxShown)) {
+    const auto u = static_cast<unsigned char>(c);
+    out += (u >= 0x20 && u < 0x7f) ? c : '?';
+  }
+  if (text.size() > kMaxShown) out += "...";
+  return out;
+}
+}  // namespace
+
+void split_csv_line(std::string_view line, std::vector<Field>& fields) {
+  fields.clear();
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    const std::size_t end = comma == std::string_view::npos ? line.size() : comma;
+    std::size_t offset = 0;
+    std::string_view text = trim(line.substr(start, end - start), offset);
+    if (text.size() >= 2 && text.front() == '"' && text.back() == '"') {
+      text = text.substr(1, text.size() - 2);
+      ++offset;
+    }
+    fields.push_back(Field{text, start + offset + 1});
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+}
+
+bool is_skippable_line(std::string_view line) noexcept {
+  for (char c : line) {
+    if (is_blank(c)) continue;
+    return c == '#';
+  }
+  return true;
+}
+
+double parse_number(const Field& field, core::SourceLocation where, std::string_view column_name) {
+  where.column = field.column;
+  std::string_view text = field.text;
+  if (text.empty())
+    throw core::InputError(where, "column '" + std::string(column_name) + "': empty value, expected a number");
+  if (text.front() == '+') text.remove_prefix(1);
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec == std::errc::result_out_of_range)
+    throw core::InputError(where, "column '" + std::string(column_name) + "': number '" + printable(field.text) +
+                                      "' is out of range");
+  if (ec != std::errc() || end != text.data() + text.size())
+    throw core::InputError(where, "column '" + std::string(column_name) + "': expected a number, found '" +
+                                      printable(field.text) + "'");
+  if (!std::isfinite(value))
+    throw core::InputError(where, "column '" + std::string(column_name) + "': value '" + printable(field.text) +
+                                      "' is not finite (NaN and infinity are not accepted)");
+  return value;
+}
+
+}  // namespace servotwin::io::detail

@@ -1,0 +1,33 @@
+#pragma once
+// Private helper: how many decimals print a time grid t0 + k ts without noise digits.
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <iterator>
+
+namespace servotwin::io::detail {
+
+/// Smallest number of decimals (at most 12) at which both t0 and ts are whole multiples of
+/// 10^-d to within 1e-9 relative: ts = 0.001 prints as 0.001, 0.002, ... rather than
+/// 0.0030000000000000001. Returns -1 when no such d exists (print shortest round-trip instead).
+inline int time_decimals(double t0, double ts) noexcept {
+  for (int d = 0; d < 12; ++d) {
+    const double scale = std::pow(10.0, d);
+    const auto whole = [scale](double v) {
+      const double scaled = v * scale;
+      return std::abs(scaled - std::round(scaled)) <= 1e-9 * std::abs(scaled);
+    };
+    if (whole(ts) && whole(t0)) return d;
+  }
+  return -1;
+}
+
+/// Appends time t with `decimals` from time_decimals (shortest round-trip when -1).
+template <typename Buffer>
+void append_time(Buffer& buffer, double t, int decimals) {
+  if (decimals >= 0) fmt::format_to(std::back_inserter(buffer), "{:.{}f}", t, decimals);
+  else fmt::format_to(std::back_inserter(buffer), "{}", t);
+}
+
+}  // namespace servotwin::io::detail
