@@ -8,6 +8,7 @@
 #include "servotwin/io/program_file.hpp"
 #include "servotwin/motion/gcode.hpp"
 #include "servotwin/motion/identification_program.hpp"
+#include "servotwin/motion/interpolation.hpp"
 
 namespace servotwin::cli {
 
@@ -81,35 +82,30 @@ void print_warnings(const motion::Program& program, const std::string& source) {
     fmt::print(stderr, "{}:{}:{}: warning: {}\n", source, w.line, w.column, w.message);
 }
 
+std::string plural(std::size_t n, const char* word) { return fmt::format("{} {}{}", n, word, n == 1 ? "" : "s"); }
+
 int run_check(const ProgramArgs& a, const GlobalOptions& /*global*/) {
   const motion::Program program = load(a);
   print_warnings(program, a.program);
   std::map<motion::BlockType, std::size_t> counts;
+  for (const auto& b : program.blocks) ++counts[b.type];
+  fmt::print("{}: {} program, {}: {}, {}, {}, {}\n", a.program,
+             program.dialect == motion::Dialect::Iso ? "ISO" : "Heidenhain", plural(program.blocks.size(), "block"),
+             plural(counts[motion::BlockType::Rapid], "rapid move"), plural(counts[motion::BlockType::Linear], "line"),
+             plural(counts[motion::BlockType::ArcCw] + counts[motion::BlockType::ArcCcw], "arc"),
+             plural(counts[motion::BlockType::Dwell], "dwell"));
+  // The plan gives the true path (arcs included) and a cycle time at the default CNC limits.
+  const motion::InterpolationLimits limits;
+  const motion::MotionPlan plan = motion::plan_motion(program, limits);
   double path_mm = 0.0;
-  motion::Point lo = program.start, hi = program.start;
-  for (const auto& b : program.blocks) {
-    ++counts[b.type];
-    if (b.type == motion::BlockType::Rapid || b.type == motion::BlockType::Linear) {
-      double d2 = 0.0;
-      for (std::size_t i = 0; i < motion::kAxisCount; ++i) d2 += (b.end[i] - b.start[i]) * (b.end[i] - b.start[i]);
-      path_mm += std::sqrt(d2);
-    }
-    for (std::size_t i = 0; i < motion::kAxisCount; ++i) {
-      lo[i] = std::min(lo[i], b.end[i]);
-      hi[i] = std::max(hi[i], b.end[i]);
-    }
+  for (const auto& move : plan.moves()) path_mm += move.length;
+  const motion::Trajectory t = motion::sample(plan);
+  for (std::size_t i = 0; i < t.axes.size(); ++i) {
+    const auto [lo, hi] = std::minmax_element(t.positions[i].begin(), t.positions[i].end());
+    fmt::print("  {}: {:.4f} .. {:.4f} mm\n", motion::axis_letter(t.axes[i]), *lo, *hi);
   }
-  fmt::print("{}: {} program, {} blocks: {} rapid, {} linear, {} arcs, {} dwells\n", a.program,
-             program.dialect == motion::Dialect::Iso ? "ISO" : "Heidenhain", program.blocks.size(),
-             counts[motion::BlockType::Rapid], counts[motion::BlockType::Linear],
-             counts[motion::BlockType::ArcCw] + counts[motion::BlockType::ArcCcw], counts[motion::BlockType::Dwell]);
-  const std::uint8_t used = program.used_axes();
-  for (std::size_t i = 0; i < motion::kAxisCount; ++i) {
-    const auto axis = static_cast<motion::Axis>(i);
-    if (used & motion::axis_bit(axis))
-      fmt::print("  {}: {:.4f} .. {:.4f} mm\n", motion::axis_letter(axis), lo[i], hi[i]);
-  }
-  fmt::print("  straight-line path length: {:.3f} mm; {} warning(s)\n", path_mm, program.warnings.size());
+  fmt::print("  path length {:.3f} mm; cycle time {:.3f} s at {} mm/s^2 (trapezoidal, rapid F{}); {}\n", path_mm,
+             plan.duration(), limits.accel, limits.rapid_feed_mm_min, plural(program.warnings.size(), "warning"));
   return kSuccess;
 }
 

@@ -34,6 +34,7 @@ void register_interpolate(CLI::App& app, Action& selected);
 void register_capture(CLI::App& app, Action& selected);
 void register_machine(CLI::App& app, Action& selected);
 void register_demo(CLI::App& app, Action& selected);
+void register_import(CLI::App& app, Action& selected);
 
 /// Progress line on stderr (suppressed by --quiet).
 template <typename... Args>

@@ -211,8 +211,13 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
       throw core::InputError({source, line_number, 0, ""},
                              fmt::format("expected {} fields as in the header, found {}", field_count, fields.size()));
     const core::SourceLocation where{source, line_number, 0, ""};
-    for (const ColumnSink& sink : sinks)
-      sink.target->push_back(detail::parse_number(fields[sink.index], where, sink.name) * sink.scale);
+    for (const ColumnSink& sink : sinks) {
+      const double value = detail::parse_number(fields[sink.index], where, sink.name) * sink.scale;
+      if (!std::isfinite(value))
+        throw core::InputError({source, line_number, fields[sink.index].column, sink.name},
+                               fmt::format("value times the scale {} overflows", sink.scale));
+      sink.target->push_back(value);
+    }
     if (!time.empty()) {
       const double t = time.back();
       if (rows > 0 && !(t > previous_t))

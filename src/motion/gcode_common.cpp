@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdio>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -84,6 +85,12 @@ std::string format_number(double value) {
   const auto r = plain ? std::to_chars(buf.data(), buf.data() + buf.size(), value, std::chars_format::fixed)
                        : std::to_chars(buf.data(), buf.data() + buf.size(), value);
   return r.ec == std::errc{} ? std::string(buf.data(), r.ptr) : std::string("?");
+}
+
+std::string format_computed(double value) {
+  std::array<char, 64> buf{};
+  const int n = std::snprintf(buf.data(), buf.size(), "%.6g", value);
+  return n > 0 ? std::string(buf.data(), static_cast<std::size_t>(n)) : std::string("?");
 }
 
 void Reporter::error(std::size_t line, std::size_t column, const std::string& message) const {
@@ -243,8 +250,8 @@ std::string check_arc_radius(const Block& block, const ArcTolerance& tolerance) 
   if (rs <= slack) return "arc centre coincides with the start point (radius 0)";
   const double tol = std::max(tolerance.abs_mm, tolerance.rel * std::max(rs, re)) + slack;
   if (std::fabs(rs - re) > tol)
-    return "arc does not close: radius " + format_number(rs) + " mm at the start, " + format_number(re) +
-           " mm at the end (difference above the tolerance of " + format_number(tol) + " mm)";
+    return "arc does not close: radius " + format_computed(rs) + " mm at the start, " + format_computed(re) +
+           " mm at the end (difference above the tolerance of " + format_computed(tol) + " mm)";
   return {};
 }
 

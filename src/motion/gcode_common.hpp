@@ -68,6 +68,8 @@ std::size_t reserve_hint(std::string_view text) noexcept;
 std::string printable(std::string_view text, std::size_t max_chars = 24);
 /// Shortest round-trip decimal text of a number, for messages.
 std::string format_number(double value);
+/// A computed value (radius, tolerance) for a message: 6 significant digits.
+std::string format_computed(double value);
 
 /// Reports errors (core::InputError with file:line:column) and lenient-mode warnings.
 class Reporter {

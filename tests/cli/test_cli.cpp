@@ -60,7 +60,7 @@ TEST_F(Cli, HelpListsCommandsAndEveryCommandHasExamples) {
   const auto top = run("--help");
   EXPECT_EQ(top.status, 0);
   for (const char* c : {"gcode", "interpolate", "capture", "machine", "demo"}) EXPECT_THAT(top.out, HasSubstr(c));
-  for (const char* c : {"gcode identification", "gcode check", "gcode convert", "interpolate", "capture", "machine", "demo"}) {
+  for (const char* c : {"gcode identification", "gcode check", "gcode convert", "interpolate", "capture", "import", "machine", "demo"}) {
     SCOPED_TRACE(c);
     const auto r = run(std::string(c) + " --help");
     EXPECT_EQ(r.status, 0);
@@ -188,6 +188,24 @@ TEST_F(Cli, DemoRunsOnTheBuiltInMachine) {
   EXPECT_THAT(r.out, HasSubstr("tracking error rms"));
   EXPECT_TRUE(fs::exists(path("run/capture.csv")));
   EXPECT_TRUE(fs::exists(path("run/identification.nc")));
+}
+
+TEST_F(Cli, ImportsTheEmpsBenchmarkWithMapAndScale) {
+  const std::string emps = SERVOTWIN_REPO_DATA_DIR "/emps/DATA_EMPS.csv";
+  auto r = run("import '" + emps + "' --map x_cmd=qg --map x_act=qm --map x_u=vir --scale 1000 -o emps.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("24841 samples at ts = 0.001"));  // data/emps/README.md
+  const std::string rewritten = slurp(path("emps.csv"));
+  EXPECT_EQ(rewritten.substr(0, rewritten.find('\n')), "t,x_cmd,x_act,x_u");
+  // The rewritten file reads back as our own format without options.
+  r = run("import emps.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("24841 samples"));
+  // Without the map the reader says which columns exist and how to map them.
+  r = run("import '" + emps + "'");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("columns: t, qm, qg, vir"));
+  EXPECT_EQ(run("import '" + emps + "' --map x_cmd").status, 3);
 }
 
 TEST_F(Cli, ConvertsBetweenDialects) {

@@ -129,6 +129,13 @@ TEST(CaptureCsv, RejectsTextNanAndInfinityNamingLineColumnAndField) {
   EXPECT_THAT(error_of("t,x_cmd,x_act\n0,0,0\n0.001,1,1e999\n"), HasSubstr("out of range"));
 }
 
+// Found by fuzz_capture_csv: a finite value that overflows once scaled was stored as infinity.
+TEST(CaptureCsv, RejectsValuesThatOverflowWhenScaled) {
+  CaptureReadOptions o;
+  o.scale = 1000.0;
+  EXPECT_THAT(error_of("t,x_cmd,x_act\n0,0,7.5e306\n0.001,1,1\n", o), HasSubstr("cap.csv:2:5 (x_act): value times the scale 1000 overflows"));
+}
+
 TEST(CaptureCsv, RejectsMissingColumnsWithAHint) {
   const std::string e = error_of("t,qg,qm\n0,0,0\n0.001,1,1\n");
   EXPECT_THAT(e, HasSubstr("no axis columns"));
