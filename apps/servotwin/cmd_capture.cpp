@@ -1,13 +1,11 @@
 // `servotwin capture`: run a part program on a virtual machine and write the capture CSV that a
 // CNC's oscilloscope would record.
 #include <chrono>
-#include <cmath>
 
 #include "command.hpp"
 #include "pipeline.hpp"
 #include "servotwin/io/capture_csv.hpp"
 #include "servotwin/io/machine_json.hpp"
-#include "servotwin/io/program_file.hpp"
 
 namespace servotwin::cli {
 
@@ -15,9 +13,8 @@ namespace {
 
 struct CaptureArgs {
   std::string machine;
-  std::string program;
-  std::string dialect = "auto";
-  bool lenient = false, ideal = false, no_u = false;
+  ProgramSource program;
+  bool ideal = false, no_u = false;
   std::uint64_t seed = 1;
   std::string output = "-";
 };
@@ -25,15 +22,8 @@ struct CaptureArgs {
 int run(const CaptureArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   const machine::MachineConfig machine = io::load_machine(a.machine);
-  motion::ParseOptions parse;
-  parse.lenient = a.lenient;
-  parse.start = machine_start(machine);
-  std::optional<motion::Dialect> dialect;
-  if (a.dialect == "iso") dialect = motion::Dialect::Iso;
-  if (a.dialect == "heidenhain") dialect = motion::Dialect::Heidenhain;
-  const motion::Program program = io::read_program_file(a.program, parse, dialect);
-  for (const auto& w : program.warnings) fmt::print(stderr, "{}:{}:{}: warning: {}\n", a.program, w.line, w.column, w.message);
-  check_program_axes(program, a.program, machine);
+  const motion::Program program = load_program(a.program, machine_start(machine));
+  check_program_axes(program, a.program.path, machine);
 
   std::vector<motion::Axis> axes;
   for (std::size_t i = 0; i < motion::kAxisCount; ++i)
@@ -54,14 +44,8 @@ int run(const CaptureArgs& a, const GlobalOptions& global) {
   io::write_capture_csv(out->stream(), capture);
   out->commit();
   for (const auto& axis : capture.axes) {
-    double sum = 0.0, peak = 0.0;
-    for (std::size_t k = 0; k < axis.cmd.size(); ++k) {
-      const double e = axis.cmd[k] - axis.act[k];
-      sum += e * e;
-      peak = std::max(peak, std::abs(e));
-    }
-    progress(global, "axis {}: tracking error rms {:.2f} um, max {:.2f} um", axis.name,
-             1000.0 * std::sqrt(sum / static_cast<double>(std::max<std::size_t>(axis.cmd.size(), 1))), 1000.0 * peak);
+    const TrackingStats s = tracking_stats(axis);
+    progress(global, "axis {}: tracking error rms {:.2f} um, max {:.2f} um", axis.name, 1000.0 * s.rms, 1000.0 * s.max);
   }
   progress(global, "wrote {}", a.output == "-" ? "capture to stdout" : a.output);
   return kSuccess;
@@ -75,14 +59,11 @@ void register_capture(CLI::App& app, Action& selected) {
       "capture", "Run a part program on a virtual machine; write the capture CSV (t, <axis>_cmd, <axis>_act, <axis>_u)");
   cmd->add_option("-m,--machine", a->machine, "Machine preset (fadal-ppi, fadal-pid, fadal-smc, ballscrew-zpetc) or JSON file")
       ->required();
-  cmd->add_option("-p,--program", a->program, "Part program (ISO or Heidenhain)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-p,--program", a->program.path, "Part program (ISO or Heidenhain)")->required()->check(CLI::ExistingFile);
   cmd->add_flag("--ideal", a->ideal, "Switch off every nonlinearity (friction, quantization, saturation, noise, delay)");
   cmd->add_option("--seed", a->seed, "Seed of the encoder noise")->capture_default_str();
   cmd->add_flag("--no-u", a->no_u, "Do not record the control signal");
-  cmd->add_option("--dialect", a->dialect, "Dialect of the program: auto, iso or heidenhain")
-      ->check(CLI::IsMember({"auto", "iso", "heidenhain"}))
-      ->capture_default_str();
-  cmd->add_flag("--lenient", a->lenient, "Report unknown G-code words as warnings instead of errors");
+  add_program_reading_options(*cmd, a->program);
   cmd->add_option("-o,--output", a->output, "Output CSV, - for standard output")->capture_default_str();
   set_examples(*cmd,
                "  servotwin capture --machine fadal-pid --program id.nc -o capture.csv\n"

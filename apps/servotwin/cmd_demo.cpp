@@ -2,7 +2,6 @@
 // program, interpolates it with the machine's CNC settings, captures it on the virtual machine and
 // prints a summary with the true closed loop that identification has to recover.
 #include <chrono>
-#include <cmath>
 #include <filesystem>
 
 #include "command.hpp"
@@ -23,22 +22,6 @@ struct DemoArgs {
   std::uint64_t seed = 1;
   std::string out_dir;
 };
-
-struct TrackingStats {
-  double rms_um = 0.0, max_um = 0.0;
-};
-
-TrackingStats tracking_stats(const core::AxisTrace& axis) {
-  TrackingStats s;
-  double sum = 0.0;
-  for (std::size_t k = 0; k < axis.cmd.size(); ++k) {
-    const double e = 1000.0 * (axis.cmd[k] - axis.act[k]);
-    sum += e * e;
-    s.max_um = std::max(s.max_um, std::abs(e));
-  }
-  s.rms_um = std::sqrt(sum / static_cast<double>(std::max<std::size_t>(axis.cmd.size(), 1)));
-  return s;
-}
 
 std::string pole_summary(const std::vector<core::ModalInfo>& roots) {
   std::string out;
@@ -86,8 +69,8 @@ int run(const DemoArgs& a, const GlobalOptions& global) {
              static_cast<double>(trajectory.size() - 1) * limits.ts);
   fmt::print("3. capture on the virtual machine (friction, saturation, DAC and encoder quantization on):\n");
   for (const auto& axis : capture.axes) {
-    const auto s = tracking_stats(axis);
-    fmt::print("   axis {}: tracking error rms {:.2f} um, max {:.2f} um\n", axis.name, s.rms_um, s.max_um);
+    const TrackingStats s = tracking_stats(axis);
+    fmt::print("   axis {}: tracking error rms {:.2f} um, max {:.2f} um\n", axis.name, 1000.0 * s.rms, 1000.0 * s.max);
   }
   fmt::print("4. true equivalent closed loop of each axis (thesis Eq. 3.3), what identification must recover:\n");
   for (const auto& axis : machine.axes) {

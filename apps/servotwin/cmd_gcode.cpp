@@ -5,7 +5,6 @@
 
 #include "command.hpp"
 #include "servotwin/core/error.hpp"
-#include "servotwin/io/program_file.hpp"
 #include "servotwin/motion/gcode.hpp"
 #include "servotwin/motion/identification_program.hpp"
 #include "servotwin/motion/interpolation.hpp"
@@ -30,9 +29,6 @@ struct IdentificationArgs {
   CLI::Option *moves_opt = nullptr, *range_opt = nullptr, *feed_opt = nullptr;
 };
 
-std::string render(const motion::Program& program, motion::Dialect dialect) {
-  return dialect == motion::Dialect::Iso ? motion::write_iso(program) : motion::write_heidenhain(program);
-}
 
 int run_identification(const IdentificationArgs& a, const GlobalOptions& global) {
   const std::map<std::string, motion::IdentificationSet> sets{{"standard", motion::IdentificationSet::Standard},
@@ -62,34 +58,18 @@ int run_identification(const IdentificationArgs& a, const GlobalOptions& global)
 }
 
 struct ProgramArgs {
-  std::string program;
-  std::string dialect = "auto";
-  bool lenient = false;
+  ProgramSource program;
   std::string to = "iso";
   std::string output = "-";
 };
 
-motion::Program load(const ProgramArgs& a) {
-  motion::ParseOptions options;
-  options.lenient = a.lenient;
-  std::optional<motion::Dialect> dialect;
-  if (a.dialect != "auto") dialect = kDialects.at(a.dialect);
-  return io::read_program_file(a.program, options, dialect);
-}
-
-void print_warnings(const motion::Program& program, const std::string& source) {
-  for (const auto& w : program.warnings)
-    fmt::print(stderr, "{}:{}:{}: warning: {}\n", source, w.line, w.column, w.message);
-}
-
 std::string plural(std::size_t n, const char* word) { return fmt::format("{} {}{}", n, word, n == 1 ? "" : "s"); }
 
 int run_check(const ProgramArgs& a, const GlobalOptions& /*global*/) {
-  const motion::Program program = load(a);
-  print_warnings(program, a.program);
+  const motion::Program program = load_program(a.program);
   std::map<motion::BlockType, std::size_t> counts;
   for (const auto& b : program.blocks) ++counts[b.type];
-  fmt::print("{}: {} program, {}: {}, {}, {}, {}\n", a.program,
+  fmt::print("{}: {} program, {}: {}, {}, {}, {}\n", a.program.path,
              program.dialect == motion::Dialect::Iso ? "ISO" : "Heidenhain", plural(program.blocks.size(), "block"),
              plural(counts[motion::BlockType::Rapid], "rapid move"), plural(counts[motion::BlockType::Linear], "line"),
              plural(counts[motion::BlockType::ArcCw] + counts[motion::BlockType::ArcCcw], "arc"),
@@ -110,22 +90,18 @@ int run_check(const ProgramArgs& a, const GlobalOptions& /*global*/) {
 }
 
 int run_convert(const ProgramArgs& a, const GlobalOptions& global) {
-  const motion::Program program = load(a);
-  print_warnings(program, a.program);
+  const motion::Program program = load_program(a.program);
   auto out = open_output(a.output, global);
-  out->stream() << render(program, kDialects.at(a.to));
+  out->stream() << (kDialects.at(a.to) == motion::Dialect::Iso ? motion::write_iso(program) : motion::write_heidenhain(program));
   out->commit();
   return kSuccess;
 }
 
 void add_program_options(CLI::App& cmd, ProgramArgs& a) {
-  cmd.add_option("program", a.program, "Part program (ISO G-code or Heidenhain conversational)")
+  cmd.add_option("program", a.program.path, "Part program (ISO G-code or Heidenhain conversational)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd.add_option("--dialect", a.dialect, "Dialect of the input: auto, iso or heidenhain")
-      ->check(CLI::IsMember({"auto", "iso", "heidenhain"}))
-      ->capture_default_str();
-  cmd.add_flag("--lenient", a.lenient, "Report unknown words as warnings instead of errors");
+  add_program_reading_options(cmd, a.program);
 }
 
 }  // namespace

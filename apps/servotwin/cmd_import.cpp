@@ -2,9 +2,9 @@
 // check it, summarize it and write it in servotwin's capture format.
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 
 #include "command.hpp"
+#include "pipeline.hpp"
 #include "servotwin/io/capture_csv.hpp"
 
 namespace servotwin::cli {
@@ -27,14 +27,9 @@ void summarize(const core::Capture& c, const std::string& source) {
              static_cast<double>(c.size() - 1) * c.ts, c.t0, c.axes.size(), c.axes.size() == 1 ? "" : "es");
   for (const auto& axis : c.axes) {
     const auto [lo, hi] = std::minmax_element(axis.cmd.begin(), axis.cmd.end());
-    double sum = 0.0, peak = 0.0;
-    for (std::size_t k = 0; k < axis.cmd.size(); ++k) {
-      const double e = axis.cmd[k] - axis.act[k];
-      sum += e * e;
-      peak = std::max(peak, std::abs(e));
-    }
-    fmt::print("  {}: command {:.6g} .. {:.6g}, tracking error rms {:.6g}, max {:.6g}{}\n", axis.name, *lo, *hi,
-               std::sqrt(sum / static_cast<double>(axis.cmd.size())), peak, axis.u.empty() ? "" : ", with control signal");
+    const TrackingStats s = tracking_stats(axis);
+    fmt::print("  {}: command {:.6g} .. {:.6g}, tracking error rms {:.6g}, max {:.6g}{}\n", axis.name, *lo, *hi, s.rms,
+               s.max, axis.u.empty() ? "" : ", with control signal");
   }
 }
 

@@ -4,7 +4,6 @@
 #include "command.hpp"
 #include "pipeline.hpp"
 #include "servotwin/io/machine_json.hpp"
-#include "servotwin/io/program_file.hpp"
 #include "servotwin/io/trajectory_csv.hpp"
 
 namespace servotwin::cli {
@@ -12,10 +11,9 @@ namespace servotwin::cli {
 namespace {
 
 struct InterpolateArgs {
-  std::string program;
+  ProgramSource program;
   std::string machine;
-  std::string dialect = "auto";
-  bool lenient = false, exact_stop = false;
+  bool exact_stop = false;
   double ts = 0.001, accel = 2000.0, jerk = 0.0, rapid = 15000.0, max_feed = 0.0, corner = 1.0;
   std::vector<std::string> axes;
   std::string output = "-";
@@ -26,12 +24,11 @@ struct InterpolateArgs {
 int run(const InterpolateArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   motion::InterpolationLimits limits;
-  motion::ParseOptions parse;
-  parse.lenient = a.lenient;
+  motion::Point home{};
   if (!a.machine.empty()) {
     const auto machine = io::load_machine(a.machine);
     limits = limits_of(machine);
-    parse.start = machine_start(machine);
+    home = machine_start(machine);
   }
   if (a.ts_opt->count() > 0) limits.ts = a.ts;
   if (a.accel_opt->count() > 0) limits.accel = a.accel;
@@ -41,11 +38,7 @@ int run(const InterpolateArgs& a, const GlobalOptions& global) {
   if (a.corner_opt->count() > 0) limits.corner_angle_deg = a.corner;
   if (a.exact_stop) limits.exact_stop_every_block = true;
 
-  std::optional<motion::Dialect> dialect;
-  if (a.dialect == "iso") dialect = motion::Dialect::Iso;
-  if (a.dialect == "heidenhain") dialect = motion::Dialect::Heidenhain;
-  const motion::Program program = io::read_program_file(a.program, parse, dialect);
-  for (const auto& w : program.warnings) fmt::print(stderr, "{}:{}:{}: warning: {}\n", a.program, w.line, w.column, w.message);
+  const motion::Program program = load_program(a.program, home);
   const motion::Trajectory trajectory = motion::interpolate(program, limits, parse_axes(a.axes, "--axes"));
 
   auto out = open_output(a.output, global);
@@ -62,7 +55,7 @@ int run(const InterpolateArgs& a, const GlobalOptions& global) {
 void register_interpolate(CLI::App& app, Action& selected) {
   auto a = std::make_shared<InterpolateArgs>();
   CLI::App* cmd = app.add_subcommand("interpolate", "Interpolate a part program into the commanded trajectory (CSV: t, <axis>_cmd)");
-  cmd->add_option("-p,--program", a->program, "Part program (ISO or Heidenhain)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-p,--program", a->program.path, "Part program (ISO or Heidenhain)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-m,--machine", a->machine, "Take ts and the CNC limits from a machine preset or JSON file");
   a->ts_opt = cmd->add_option("--ts", a->ts, "Sample period [s]")->capture_default_str();
   a->accel_opt = cmd->add_option("--accel", a->accel, "Acceleration limit along the path [mm/s^2]")->capture_default_str();
@@ -73,10 +66,7 @@ void register_interpolate(CLI::App& app, Action& selected) {
                       ->capture_default_str();
   cmd->add_flag("--exact-stop", a->exact_stop, "Stop exactly at the end of every block (G61, no look-ahead)");
   cmd->add_option("--axes", a->axes, "Axes to write, e.g. XY (default: the axes the program uses)");
-  cmd->add_option("--dialect", a->dialect, "Dialect of the program: auto, iso or heidenhain")
-      ->check(CLI::IsMember({"auto", "iso", "heidenhain"}))
-      ->capture_default_str();
-  cmd->add_flag("--lenient", a->lenient, "Report unknown G-code words as warnings instead of errors");
+  add_program_reading_options(*cmd, a->program);
   cmd->add_option("-o,--output", a->output, "Output CSV, - for standard output")->capture_default_str();
   set_examples(*cmd,
                "  servotwin interpolate --program id.nc --ts 0.001 --accel 2000 -o trajectory.csv\n"

@@ -3,6 +3,7 @@
 #include <cctype>
 
 #include "servotwin/core/error.hpp"
+#include "servotwin/io/program_file.hpp"
 
 namespace servotwin::cli {
 
@@ -29,6 +30,26 @@ std::vector<motion::Axis> parse_axes(const std::vector<std::string>& values, con
     }
   }
   return axes;
+}
+
+void add_program_reading_options(CLI::App& command, ProgramSource& source) {
+  command.add_option("--dialect", source.dialect, "Dialect of the program: auto, iso or heidenhain")
+      ->check(CLI::IsMember({"auto", "iso", "heidenhain"}))
+      ->capture_default_str();
+  command.add_flag("--lenient", source.lenient, "Report unknown G-code words as warnings instead of errors");
+}
+
+motion::Program load_program(const ProgramSource& source, const motion::Point& start) {
+  motion::ParseOptions options;
+  options.lenient = source.lenient;
+  options.start = start;
+  std::optional<motion::Dialect> dialect;
+  if (source.dialect == "iso") dialect = motion::Dialect::Iso;
+  if (source.dialect == "heidenhain") dialect = motion::Dialect::Heidenhain;
+  motion::Program program = io::read_program_file(source.path, options, dialect);
+  for (const auto& w : program.warnings)
+    fmt::print(stderr, "{}:{}:{}: warning: {}\n", source.path, w.line, w.column, w.message);
+  return program;
 }
 
 void set_examples(CLI::App& command, const std::string& examples) { command.footer("\nExamples:\n" + examples); }

@@ -51,6 +51,18 @@ std::unique_ptr<io::OutputFile> open_output(const std::string& path, const Globa
 /// Parses axis lists such as "X", "xy", "X,Y" (repeatable option values) into axes.
 std::vector<motion::Axis> parse_axes(const std::vector<std::string>& values, const std::string& option);
 
+/// Where a part program comes from and how to read it: the options every command that reads a
+/// program shares.
+struct ProgramSource {
+  std::string path;
+  std::string dialect = "auto";  ///< auto, iso or heidenhain
+  bool lenient = false;
+};
+/// Adds --dialect and --lenient for `source`.
+void add_program_reading_options(CLI::App& command, ProgramSource& source);
+/// Reads the program starting from `start`, printing lenient-mode warnings on stderr.
+motion::Program load_program(const ProgramSource& source, const motion::Point& start = {});
+
 /// Adds the "Examples:" footer shown by --help.
 void set_examples(CLI::App& command, const std::string& examples);
 

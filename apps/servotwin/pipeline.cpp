@@ -1,8 +1,23 @@
 #include "pipeline.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "servotwin/core/error.hpp"
 
 namespace servotwin::cli {
+
+TrackingStats tracking_stats(const core::AxisTrace& axis) {
+  TrackingStats s;
+  double sum = 0.0;
+  for (std::size_t k = 0; k < axis.cmd.size(); ++k) {
+    const double e = axis.cmd[k] - axis.act[k];
+    sum += e * e;
+    s.max = std::max(s.max, std::abs(e));
+  }
+  s.rms = axis.cmd.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(axis.cmd.size()));
+  return s;
+}
 
 motion::InterpolationLimits limits_of(const machine::MachineConfig& machine) {
   motion::InterpolationLimits limits;

@@ -13,6 +13,13 @@
 
 namespace servotwin::cli {
 
+/// Tracking error x_r - x of one axis over a capture, in the capture's length unit.
+struct TrackingStats {
+  double rms = 0.0;
+  double max = 0.0;
+};
+TrackingStats tracking_stats(const core::AxisTrace& axis);
+
 /// Interpolator limits of a machine's CNC.
 motion::InterpolationLimits limits_of(const machine::MachineConfig& machine);
 

@@ -277,12 +277,9 @@ void write_capture_csv(std::ostream& out, const core::Capture& capture) {
       if (!axis.u.empty()) fmt::format_to(std::back_inserter(buffer), ",{}", axis.u[k]);
     }
     buffer.push_back('\n');
-    if (buffer.size() > (std::size_t{1} << 16)) {
-      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-      buffer.clear();
-    }
+    detail::write_out_when_full(buffer, out);
   }
-  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  detail::write_out(buffer, out);
 }
 
 }  // namespace servotwin::io

@@ -1,10 +1,11 @@
 #pragma once
-// Private helper: how many decimals print a time grid t0 + k ts without noise digits.
+// Private helpers of the CSV writers: time formatting and chunked output.
 
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
 #include <iterator>
+#include <ostream>
 
 namespace servotwin::io::detail {
 
@@ -28,6 +29,19 @@ template <typename Buffer>
 void append_time(Buffer& buffer, double t, int decimals) {
   if (decimals >= 0) fmt::format_to(std::back_inserter(buffer), "{:.{}f}", t, decimals);
   else fmt::format_to(std::back_inserter(buffer), "{}", t);
+}
+
+/// Writes the buffer to `out` and empties it.
+template <typename Buffer>
+void write_out(Buffer& buffer, std::ostream& out) {
+  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  buffer.clear();
+}
+
+/// Writes the buffer out once it holds more than 64 KiB, so long files stream with flat memory.
+template <typename Buffer>
+void write_out_when_full(Buffer& buffer, std::ostream& out) {
+  if (buffer.size() > (std::size_t{1} << 16)) write_out(buffer, out);
 }
 
 }  // namespace servotwin::io::detail

@@ -18,12 +18,9 @@ void write_trajectory_csv(std::ostream& out, const motion::Trajectory& trajector
     detail::append_time(buffer, static_cast<double>(k) * trajectory.ts, decimals);
     for (const auto& column : trajectory.positions) fmt::format_to(std::back_inserter(buffer), ",{}", column[k]);
     buffer.push_back('\n');
-    if (buffer.size() > (std::size_t{1} << 16)) {
-      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-      buffer.clear();
-    }
+    detail::write_out_when_full(buffer, out);
   }
-  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  detail::write_out(buffer, out);
 }
 
 }  // namespace servotwin::io

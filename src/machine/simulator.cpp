@@ -19,47 +19,63 @@ namespace {
 // compute(y, r): y = reading y(k), r points at x_r(k) with r[-1] ... r[preview] valid.
 // commit(u): the value actually sent to the amplifier (after saturation and DAC).
 
+// The signals both PID-form laws differentiate: the command by central differences (the
+// interpolator provides one sample of look-ahead), the reading by a backward difference.
+class SampledDerivatives {
+ public:
+  struct Values {
+    double ref_v, ref_a, meas_v;
+  };
+  explicit SampledDerivatives(double ts) : inv_ts_(1.0 / ts), inv_ts2_(1.0 / (ts * ts)) {}
+  void reset(double y0) noexcept { y_prev_ = y0; }
+  Values update(double y, const double* r) noexcept {
+    const Values v{0.5 * (r[1] - r[-1]) * inv_ts_, (r[1] - 2.0 * r[0] + r[-1]) * inv_ts2_, (y - y_prev_) * inv_ts_};
+    y_prev_ = y;
+    return v;
+  }
+
+ private:
+  double inv_ts_, inv_ts2_;
+  double y_prev_ = 0.0;
+};
+
 class PidLaw {
  public:
-  PidLaw(const PidController& c, double ts) : c_(c), ts_(ts), inv_ts_(1.0 / ts), inv_ts2_(1.0 / (ts * ts)) {}
-  void reset(double y0) noexcept { y_prev_ = y0; }
+  PidLaw(const PidController& c, double ts) : c_(c), ts_(ts), d_(ts) {}
+  void reset(double y0) noexcept { d_.reset(y0); }
   double compute(double y, const double* r) noexcept {
     const double e = r[0] - y;
     integral_ += ts_ * e;
-    const double ref_v = 0.5 * (r[1] - r[-1]) * inv_ts_;
-    const double ref_a = (r[1] - 2.0 * r[0] + r[-1]) * inv_ts2_;
-    const double meas_v = (y - y_prev_) * inv_ts_;
-    y_prev_ = y;
-    return c_.kp * e + c_.ki * integral_ + c_.kd * (ref_v - meas_v) + c_.vel_ff * ref_v + c_.acc_ff * ref_a;
+    const auto d = d_.update(y, r);
+    return c_.kp * e + c_.ki * integral_ + c_.kd * (d.ref_v - d.meas_v) + c_.vel_ff * d.ref_v + c_.acc_ff * d.ref_a;
   }
   void commit(double) noexcept {}
 
  private:
   PidController c_;
-  double ts_, inv_ts_, inv_ts2_;
-  double integral_ = 0.0, y_prev_ = 0.0;
+  double ts_;
+  SampledDerivatives d_;
+  double integral_ = 0.0;
 };
 
 class PPiLaw {
  public:
-  PPiLaw(const PPiController& c, double ts) : c_(c), ts_(ts), inv_ts_(1.0 / ts), inv_ts2_(1.0 / (ts * ts)) {}
-  void reset(double y0) noexcept { y_prev_ = y0; }
+  PPiLaw(const PPiController& c, double ts) : c_(c), ts_(ts), d_(ts) {}
+  void reset(double y0) noexcept { d_.reset(y0); }
   double compute(double y, const double* r) noexcept {
-    const double ref_v = 0.5 * (r[1] - r[-1]) * inv_ts_;
-    const double ref_a = (r[1] - 2.0 * r[0] + r[-1]) * inv_ts2_;
-    const double meas_v = (y - y_prev_) * inv_ts_;
-    y_prev_ = y;
-    const double velocity_command = c_.kp * (r[0] - y) + c_.vel_ff * ref_v;
-    const double velocity_error = velocity_command - meas_v;
+    const auto d = d_.update(y, r);
+    const double velocity_command = c_.kp * (r[0] - y) + c_.vel_ff * d.ref_v;
+    const double velocity_error = velocity_command - d.meas_v;
     integral_ += ts_ * velocity_error;
-    return c_.kv * velocity_error + c_.ki * integral_ + c_.acc_ff * ref_a;
+    return c_.kv * velocity_error + c_.ki * integral_ + c_.acc_ff * d.ref_a;
   }
   void commit(double) noexcept {}
 
  private:
   PPiController c_;
-  double ts_, inv_ts_, inv_ts2_;
-  double integral_ = 0.0, y_prev_ = 0.0;
+  double ts_;
+  SampledDerivatives d_;
+  double integral_ = 0.0;
 };
 
 class SlidingModeLaw {
@@ -70,25 +86,22 @@ class SlidingModeLaw {
         rho_ts_(c.rho * ts),
         jm_(c.model_inertia.value_or(plant.inertia) / c.model_gain.value_or(plant.gain)),
         bm_(c.model_damping.value_or(plant.damping) / c.model_gain.value_or(plant.gain)),
-        inv_ts_(1.0 / ts),
-        inv_ts2_(1.0 / (ts * ts)) {}
-  void reset(double y0) noexcept { y_prev_ = y0; }
+        d_(ts) {}
+  void reset(double y0) noexcept { d_.reset(y0); }
   double compute(double y, const double* r) noexcept {
-    const double ref_v = 0.5 * (r[1] - r[-1]) * inv_ts_;
-    const double ref_a = (r[1] - 2.0 * r[0] + r[-1]) * inv_ts2_;
-    const double meas_v = (y - y_prev_) * inv_ts_;
-    y_prev_ = y;
+    const auto d = d_.update(y, r);
     const double e = r[0] - y;
-    const double e_rate = ref_v - meas_v;
+    const double e_rate = d.ref_v - d.meas_v;
     const double surface = e_rate + lambda_ * e;
     disturbance_ += rho_ts_ * surface;  // adaptation d_hat' = rho S, backward Euler
-    return jm_ * (ref_a + lambda_ * e_rate) + bm_ * (ref_v + lambda_ * e) + ks_ * surface + disturbance_;
+    return jm_ * (d.ref_a + lambda_ * e_rate) + bm_ * (d.ref_v + lambda_ * e) + ks_ * surface + disturbance_;
   }
   void commit(double) noexcept {}
 
  private:
-  double lambda_, ks_, rho_ts_, jm_, bm_, inv_ts_, inv_ts2_;
-  double disturbance_ = 0.0, y_prev_ = 0.0;
+  double lambda_, ks_, rho_ts_, jm_, bm_;
+  SampledDerivatives d_;
+  double disturbance_ = 0.0;
 };
 
 class PolePlacementLaw {

@@ -71,6 +71,13 @@ std::string format_number(double value);
 /// A computed value (radius, tolerance) for a message: 6 significant digits.
 std::string format_computed(double value);
 
+/// A value word of a line (X, I, F, R, ...): raw value in program units and where it stood.
+struct ValueWord {
+  bool present = false;
+  double value = 0.0;
+  std::size_t column = 0;
+};
+
 /// Reports errors (core::InputError with file:line:column) and lenient-mode warnings.
 class Reporter {
  public:

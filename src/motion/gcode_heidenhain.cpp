@@ -17,12 +17,7 @@ using detail::equals_upper;
 using detail::NumberStatus;
 using detail::Reporter;
 using detail::ScannedNumber;
-
-struct ValueWord {
-  bool present = false;
-  double value = 0.0;
-  std::size_t column = 0;
-};
+using detail::ValueWord;
 
 /// Coordinates of a block: absolute (X) or incremental (IX) per axis.
 struct AxisWords {
@@ -266,14 +261,18 @@ class HeidenhainReader {
     return true;
   }
 
+  /// A `;` comment runs to the end of the line: stores it in the block and says whether one was there.
+  bool take_comment(const Cursor& c, Block& block) const {
+    if (c.peek() != ';') return false;
+    block.comment = std::string(detail::trim(line_.substr(c.pos + 1)));
+    return true;
+  }
+
   void read_path_words(Cursor& c, PathWords& w, Block& block, PathKind kind) {
     while (true) {
       c.skip_blanks();
       if (c.at_end()) return;
-      if (c.peek() == ';') {
-        block.comment = std::string(detail::trim(line_.substr(c.pos + 1)));
-        return;
-      }
+      if (take_comment(c, block)) return;
       const std::size_t col = c.column();
       const std::string_view letters = c.take_letters();
       if (letters.empty()) {
@@ -481,10 +480,7 @@ class HeidenhainReader {
     while (true) {
       c.skip_blanks();
       if (c.at_end()) break;
-      if (c.peek() == ';') {
-        block.comment = std::string(detail::trim(line_.substr(c.pos + 1)));
-        break;
-      }
+      if (take_comment(c, block)) break;
       const std::size_t col = c.column();
       const std::string_view letters = c.take_letters();
       if (equals_upper(letters, "M")) {
@@ -526,10 +522,7 @@ class HeidenhainReader {
     while (true) {
       c.skip_blanks();
       if (c.at_end()) break;
-      if (c.peek() == ';') {
-        block.comment = std::string(detail::trim(line_.substr(c.pos + 1)));
-        break;
-      }
+      if (take_comment(c, block)) break;
       const std::size_t col = c.column();
       const std::string_view letters = c.take_letters();
       std::size_t a = 0;
@@ -584,10 +577,7 @@ class HeidenhainReader {
     while (true) {
       c.skip_blanks();
       if (c.at_end()) break;
-      if (c.peek() == ';') {
-        block.comment = std::string(detail::trim(line_.substr(c.pos + 1)));
-        break;
-      }
+      if (take_comment(c, block)) break;
       const std::size_t col = c.column();
       const std::string_view letters = c.take_letters();
       if (equals_upper(letters, "S") && !has_speed) {

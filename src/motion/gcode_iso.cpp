@@ -15,13 +15,7 @@ using detail::Cursor;
 using detail::NumberStatus;
 using detail::Reporter;
 using detail::ScannedNumber;
-
-/// A value word of the line (X, I, F, ...): raw value in program units.
-struct ValueWord {
-  bool present = false;
-  double value = 0.0;
-  std::size_t column = 0;
-};
+using detail::ValueWord;
 
 /// One G word kept per modal group: its code (10 x the G number, so G90.1 = 901) and column.
 struct GroupWord {

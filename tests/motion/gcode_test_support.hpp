@@ -16,6 +16,30 @@
 
 namespace servotwin::motion::test {
 
+// Thesis Table 4.4, blocks 0..13 as printed, then the program end (blocks 104..108 renumbered);
+// shared by the reader and writer tests.
+inline constexpr const char* kThesisTable44 =
+    "0 BEGIN PGM RAPIDIDENT MM\n"
+    ";Rapid Identification on TNC 430 5 axis machine\n"
+    "1 BLK FORM 0.1 Z X-50.000 Y-50.000 Z-50.000\n"
+    "2 BLK FORM 0.2 X+50.000 Y+50.000 Z+50.000\n"
+    "3 TOOL CALL 0 Z\n"
+    "4 L Z+200.000 F MAX\n"
+    "5 L X+0.000 Y+0.000 R0 F MAX M3\n"
+    "6 L Z+0.000 F MAX\n"
+    "7 L X-9.375 F 15000.000\n"
+    "8 L X+9.375\n"
+    "9 L X-5.280\n"
+    "10 L X-5.552\n"
+    "11 L X+0.158\n"
+    "12 L X+6.539\n"
+    "13 L X-1.538\n"
+    "14 L X-9.375\n"
+    "15 L X+9.375\n"
+    "16 L X+0.000\n"
+    "17 M30\n"
+    "18 END PGM RAPIDIDENT MM\n";
+
 /// Message of the core::InputError thrown by `f`, or "" when it does not throw one (other
 /// exceptions propagate and fail the test).
 inline std::string input_error(const std::function<void()>& f) {

@@ -21,31 +21,9 @@ constexpr std::uint8_t kX = axis_bit(Axis::X);
 constexpr std::uint8_t kY = axis_bit(Axis::Y);
 constexpr std::uint8_t kZ = axis_bit(Axis::Z);
 
-// Table 4.4, blocks 0..13 as printed, then the program end (blocks 104..108 renumbered).
-constexpr const char* kTable44 =
-    "0 BEGIN PGM RAPIDIDENT MM\n"
-    ";Rapid Identification on TNC 430 5 axis machine\n"
-    "1 BLK FORM 0.1 Z X-50.000 Y-50.000 Z-50.000\n"
-    "2 BLK FORM 0.2 X+50.000 Y+50.000 Z+50.000\n"
-    "3 TOOL CALL 0 Z\n"
-    "4 L Z+200.000 F MAX\n"
-    "5 L X+0.000 Y+0.000 R0 F MAX M3\n"
-    "6 L Z+0.000 F MAX\n"
-    "7 L X-9.375 F 15000.000\n"
-    "8 L X+9.375\n"
-    "9 L X-5.280\n"
-    "10 L X-5.552\n"
-    "11 L X+0.158\n"
-    "12 L X+6.539\n"
-    "13 L X-1.538\n"
-    "14 L X-9.375\n"
-    "15 L X+9.375\n"
-    "16 L X+0.000\n"
-    "17 M30\n"
-    "18 END PGM RAPIDIDENT MM\n";
 
 TEST(GcodeHeidenhain, ReadsThesisTable44) {
-  const Program p = heidenhain(kTable44);
+  const Program p = heidenhain(test::kThesisTable44);
   EXPECT_EQ(p.dialect, Dialect::Heidenhain);
   EXPECT_EQ(p.name, "RAPIDIDENT");
   EXPECT_TRUE(p.warnings.empty());
@@ -276,12 +254,12 @@ TEST(GcodeHeidenhain, MalformedNumbers) {
 }
 
 TEST(GcodeHeidenhain, DetectsDialect) {
-  EXPECT_EQ(detect_dialect(kTable44), Dialect::Heidenhain);
+  EXPECT_EQ(detect_dialect(test::kThesisTable44), Dialect::Heidenhain);
   EXPECT_EQ(detect_dialect("; note\n\n  0   begin pgm X mm\n"), Dialect::Heidenhain);
   EXPECT_EQ(detect_dialect("%\n(BEGIN PGM in a comment)\nN10 G00 X0\n"), Dialect::Iso);
   EXPECT_EQ(detect_dialect("BEGINNING X1\n"), Dialect::Iso);
   EXPECT_EQ(detect_dialect(""), Dialect::Iso);
-  EXPECT_EQ(parse_program(kTable44, "a").dialect, Dialect::Heidenhain);
+  EXPECT_EQ(parse_program(test::kThesisTable44, "a").dialect, Dialect::Heidenhain);
   EXPECT_EQ(parse_program("G00 X1\n", "a").dialect, Dialect::Iso);
   EXPECT_THROW(parse_program("G00 X1\n", "a", {}, Dialect::Heidenhain), core::InputError);
 }

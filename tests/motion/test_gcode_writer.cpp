@@ -30,29 +30,9 @@ constexpr const char* kTable32 =
     "N2000 G01 X-2.641\n"
     "N2010 G01 X 0.000\n";
 
-// Thesis Table 4.4 as printed (first blocks and the end).
-constexpr const char* kTable44 =
-    "0 BEGIN PGM RAPIDIDENT MM\n"
-    ";Rapid Identification on TNC 430 5 axis machine\n"
-    "1 BLK FORM 0.1 Z X-50.000 Y-50.000 Z-50.000\n"
-    "2 BLK FORM 0.2 X+50.000 Y+50.000 Z+50.000\n"
-    "3 TOOL CALL 0 Z\n"
-    "4 L Z+200.000 F MAX\n"
-    "5 L X+0.000 Y+0.000 R0 F MAX M3\n"
-    "6 L Z+0.000 F MAX\n"
-    "7 L X-9.375 F 15000.000\n"
-    "8 L X+9.375\n"
-    "9 L X-5.280\n"
-    "10 L X-5.552\n"
-    "11 L X+0.158\n"
-    "12 L X-9.375\n"
-    "13 L X+9.375\n"
-    "14 L X+0.000\n"
-    "15 M30\n"
-    "16 END PGM RAPIDIDENT MM\n";
 
 TEST(GcodeWriter, ReproducesThesisTable44) {
-  EXPECT_EQ(write_heidenhain(heidenhain(kTable44)), kTable44);
+  EXPECT_EQ(write_heidenhain(heidenhain(test::kThesisTable44)), test::kThesisTable44);
 }
 
 TEST(GcodeWriter, ReproducesThesisTable32) {
@@ -243,7 +223,7 @@ TEST(GcodeWriter, HeidenhainRoundTripKeepsEveryBlockButNumbers) {
 TEST(GcodeWriter, CrossDialectRoundTrips) {
   const Program from_iso = iso(kIsoFeatures);
   expect_same_motion(from_iso, heidenhain(write_heidenhain(from_iso)));
-  const Program from_h = heidenhain(kTable44);
+  const Program from_h = heidenhain(test::kThesisTable44);
   const Program via_iso = iso(write_iso(from_h));
   expect_same_motion(from_h, via_iso);
   // Heidenhain statements become ISO comments.
