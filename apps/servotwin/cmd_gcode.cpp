@@ -109,6 +109,10 @@ void add_program_options(CLI::App& cmd, ProgramArgs& a) {
 void register_gcode(CLI::App& app, Action& selected) {
   CLI::App* gcode = app.add_subcommand("gcode", "Generate, check and convert part programs");
   gcode->require_subcommand(1);
+  set_examples(*gcode,
+               "  servotwin gcode identification --axis X --seed 7 -o id.nc\n"
+               "  servotwin gcode check id.nc\n"
+               "  servotwin gcode convert id.nc --to heidenhain -o id.h\n");
 
   auto id = std::make_shared<IdentificationArgs>();
   CLI::App* gen = gcode->add_subcommand(
