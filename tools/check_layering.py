@@ -18,8 +18,9 @@ ALLOWED = {
     "fit": {"core"},
     "shaping": {"core", "fit"},
     "tuning": {"core", "fit"},
-    "io": {"core", "motion", "machine", "rapid", "frf", "fit", "shaping", "tuning"},
-    "report": {"core", "motion", "machine", "rapid", "frf", "fit", "shaping", "tuning", "io"},
+    "vcnc": {"core", "motion", "machine", "rapid"},
+    "io": {"core", "motion", "machine", "rapid", "vcnc", "frf", "fit", "shaping", "tuning"},
+    "report": {"core", "motion", "machine", "rapid", "vcnc", "frf", "fit", "shaping", "tuning", "io"},
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]servotwin/([a-z_]+)/')
 

@@ -3,7 +3,7 @@
 #include <chrono>
 
 #include "command.hpp"
-#include "pipeline.hpp"
+#include "servotwin/vcnc/machine_run.hpp"
 #include "servotwin/io/capture_csv.hpp"
 #include "servotwin/io/machine_json.hpp"
 
@@ -22,13 +22,11 @@ struct CaptureArgs {
 int run(const CaptureArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   const machine::MachineConfig machine = io::load_machine(a.machine);
-  const motion::Program program = load_program(a.program, machine_start(machine));
-  check_program_axes(program, a.program.path, machine);
+  const motion::Program program = load_program(a.program, vcnc::machine_start(machine));
+  vcnc::check_program_axes(program, a.program.path, machine);
 
-  std::vector<motion::Axis> axes;
-  for (std::size_t i = 0; i < motion::kAxisCount; ++i)
-    if (machine_axis_index(machine, static_cast<motion::Axis>(i)) >= 0) axes.push_back(static_cast<motion::Axis>(i));
-  const motion::Trajectory trajectory = motion::interpolate(program, limits_of(machine), axes);
+  const motion::Trajectory trajectory =
+      motion::interpolate(program, vcnc::limits_of(machine), vcnc::program_axes_of(machine));
   progress(global, "interpolated {} samples ({:.3f} s) in {:.1f} ms", trajectory.size(),
            static_cast<double>(trajectory.size()) * machine.ts, elapsed_ms(start));
 
@@ -36,7 +34,7 @@ int run(const CaptureArgs& a, const GlobalOptions& global) {
   sim.ideal = a.ideal;
   sim.seed = a.seed;
   sim.record_u = !a.no_u;
-  const core::Capture capture = machine::simulate(machine, machine_commands(machine, trajectory), sim);
+  const core::Capture capture = machine::simulate(machine, vcnc::machine_commands(machine, trajectory), sim);
   progress(global, "simulated machine '{}' ({} axes{}) in {:.1f} ms total", machine.name, machine.axes.size(),
            a.ideal ? ", ideal" : "", elapsed_ms(start));
 
@@ -44,7 +42,7 @@ int run(const CaptureArgs& a, const GlobalOptions& global) {
   io::write_capture_csv(out->stream(), capture);
   out->commit();
   for (const auto& axis : capture.axes) {
-    const TrackingStats s = tracking_stats(axis);
+    const vcnc::TrackingStats s = vcnc::tracking_stats(axis);
     progress(global, "axis {}: tracking error rms {:.2f} um, max {:.2f} um", axis.name, 1000.0 * s.rms, 1000.0 * s.max);
   }
   progress(global, "wrote {}", a.output == "-" ? "capture to stdout" : a.output);

@@ -4,7 +4,8 @@
 #include <chrono>
 
 #include "command.hpp"
-#include "pipeline.hpp"
+#include "capture_input.hpp"
+#include "servotwin/vcnc/machine_run.hpp"
 #include "servotwin/io/capture_csv.hpp"
 
 namespace servotwin::cli {
@@ -13,13 +14,9 @@ namespace {
 
 struct ImportArgs {
   std::string input;
-  std::vector<std::string> maps;
-  double scale = 1.0;
-  double ts = 0.0;
-  double max_jitter = 0.01;
+  CaptureInput reading;
   std::vector<std::string> axes;
   std::string output;
-  CLI::Option* ts_opt = nullptr;
 };
 
 void summarize(const core::Capture& c, const std::string& source) {
@@ -27,7 +24,7 @@ void summarize(const core::Capture& c, const std::string& source) {
              static_cast<double>(c.size() - 1) * c.ts, c.t0, c.axes.size(), c.axes.size() == 1 ? "" : "es");
   for (const auto& axis : c.axes) {
     const auto [lo, hi] = std::minmax_element(axis.cmd.begin(), axis.cmd.end());
-    const TrackingStats s = tracking_stats(axis);
+    const vcnc::TrackingStats s = vcnc::tracking_stats(axis);
     fmt::print("  {}: command {:.6g} .. {:.6g}, tracking error rms {:.6g}, max {:.6g}{}\n", axis.name, *lo, *hi, s.rms,
                s.max, axis.u.empty() ? "" : ", with control signal");
   }
@@ -35,11 +32,7 @@ void summarize(const core::Capture& c, const std::string& source) {
 
 int run(const ImportArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
-  io::CaptureReadOptions options;
-  for (const auto& m : a.maps) options.map.push_back(io::parse_column_mapping(m));
-  options.scale = a.scale;
-  options.max_jitter = a.max_jitter;
-  if (a.ts_opt->count() > 0) options.ts = a.ts;
+  io::CaptureReadOptions options = capture_read_options(a.reading);
   for (const auto& axis : a.axes) options.axes.push_back(axis);
   const core::Capture capture = io::read_capture_file(a.input, options);
   progress(global, "read {} in {:.1f} ms", a.input, elapsed_ms(start));
@@ -60,11 +53,7 @@ void register_import(CLI::App& app, Action& selected) {
   CLI::App* cmd = app.add_subcommand(
       "import", "Read a foreign capture CSV (column map, unit scale), check and summarize it, optionally rewrite it");
   cmd->add_option("capture", a->input, "CSV with a header row")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--map", a->maps, "Column of the file for one of ours: t=, <axis>_cmd=, <axis>_act=, <axis>_u= (repeatable)");
-  cmd->add_option("--scale", a->scale, "Factor applied to positions, e.g. 1000 for metres -> mm")->capture_default_str();
-  a->ts_opt = cmd->add_option("--ts", a->ts, "Sample period [s] for files without a time column");
-  cmd->add_option("--max-jitter", a->max_jitter, "Largest accepted time-stamp deviation from the uniform grid, as a fraction of ts")
-      ->capture_default_str();
+  add_capture_input_options(*cmd, a->reading);
   cmd->add_option("--axis", a->axes, "Axes to read (default: every <axis>_cmd/<axis>_act pair)");
   cmd->add_option("-o,--output", a->output, "Write the capture in servotwin's format (t, <axis>_cmd, <axis>_act, <axis>_u)");
   set_examples(*cmd,

@@ -2,7 +2,7 @@
 #include <chrono>
 
 #include "command.hpp"
-#include "pipeline.hpp"
+#include "servotwin/vcnc/machine_run.hpp"
 #include "servotwin/io/machine_json.hpp"
 #include "servotwin/io/trajectory_csv.hpp"
 
@@ -27,8 +27,8 @@ int run(const InterpolateArgs& a, const GlobalOptions& global) {
   motion::Point home{};
   if (!a.machine.empty()) {
     const auto machine = io::load_machine(a.machine);
-    limits = limits_of(machine);
-    home = machine_start(machine);
+    limits = vcnc::limits_of(machine);
+    home = vcnc::machine_start(machine);
   }
   if (a.ts_opt->count() > 0) limits.ts = a.ts;
   if (a.accel_opt->count() > 0) limits.accel = a.accel;

@@ -35,6 +35,9 @@ void register_capture(CLI::App& app, Action& selected);
 void register_machine(CLI::App& app, Action& selected);
 void register_demo(CLI::App& app, Action& selected);
 void register_import(CLI::App& app, Action& selected);
+void register_identify(CLI::App& app, Action& selected);
+void register_solve(CLI::App& app, Action& selected);
+void register_model(CLI::App& app, Action& selected);
 
 /// Progress line on stderr (suppressed by --quiet).
 template <typename... Args>

@@ -22,7 +22,8 @@ int main(int argc, char** argv) {
       "Exit status: 0 success, 2 usage error, 3 bad input (file, value), 1 internal error.");
 
   Action selected;
-  for (Registrar add : {register_gcode, register_interpolate, register_capture, register_import, register_machine, register_demo})
+  for (Registrar add : {register_gcode, register_interpolate, register_capture, register_import, register_identify, register_solve,
+                         register_model, register_machine, register_demo})
     add(app, selected);
 
   try {

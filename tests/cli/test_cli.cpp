@@ -10,51 +10,14 @@
 #include <sstream>
 #include <sys/wait.h>
 
+#include "cli_support.hpp"
+
 namespace {
 
-namespace fs = std::filesystem;
+using servotwin::cli_test::Cli;
+using servotwin::cli_test::slurp;
 using ::testing::HasSubstr;
-
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class Cli : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("servotwin-cli-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  Result run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = "cd '" + dir_.string() + "' && '" + SERVOTWIN_CLI + "' " + args + " > '" + out.string() +
-                                "' 2> '" + err.string() + "'";
-    const int raw = std::system(command.c_str());
-    Result r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    fs::remove(out);
-    fs::remove(err);
-    return r;
-  }
-  void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name) << text; }
-  [[nodiscard]] fs::path path(const std::string& name) const { return dir_ / name; }
-
-  fs::path dir_;
-};
+namespace fs = std::filesystem;
 
 TEST_F(Cli, HelpListsCommandsAndEveryCommandHasExamples) {
   const auto top = run("--help");

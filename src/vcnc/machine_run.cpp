@@ -1,23 +1,11 @@
-#include "pipeline.hpp"
+#include "servotwin/vcnc/machine_run.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "servotwin/core/error.hpp"
 
-namespace servotwin::cli {
-
-TrackingStats tracking_stats(const core::AxisTrace& axis) {
-  TrackingStats s;
-  double sum = 0.0;
-  for (std::size_t k = 0; k < axis.cmd.size(); ++k) {
-    const double e = axis.cmd[k] - axis.act[k];
-    sum += e * e;
-    s.max = std::max(s.max, std::abs(e));
-  }
-  s.rms = axis.cmd.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(axis.cmd.size()));
-  return s;
-}
+namespace servotwin::vcnc {
 
 motion::InterpolationLimits limits_of(const machine::MachineConfig& machine) {
   motion::InterpolationLimits limits;
@@ -34,6 +22,13 @@ int machine_axis_index(const machine::MachineConfig& machine, motion::Axis axis)
   for (std::size_t i = 0; i < machine.axes.size(); ++i)
     if (machine.axes[i].name == motion::axis_name(axis)) return static_cast<int>(i);
   return -1;
+}
+
+std::vector<motion::Axis> program_axes_of(const machine::MachineConfig& machine) {
+  std::vector<motion::Axis> axes;
+  for (std::size_t i = 0; i < motion::kAxisCount; ++i)
+    if (machine_axis_index(machine, static_cast<motion::Axis>(i)) >= 0) axes.push_back(static_cast<motion::Axis>(i));
+  return axes;
 }
 
 motion::Point machine_start(const machine::MachineConfig& machine) {
@@ -72,4 +67,23 @@ std::vector<std::vector<double>> machine_commands(const machine::MachineConfig& 
   return commands;
 }
 
-}  // namespace servotwin::cli
+core::Capture run_program(const machine::MachineConfig& machine, const motion::Program& program,
+                          const machine::SimulationOptions& options) {
+  check_program_axes(program, program.name, machine);
+  const motion::Trajectory trajectory = motion::interpolate(program, limits_of(machine), program_axes_of(machine));
+  return machine::simulate(machine, machine_commands(machine, trajectory), options);
+}
+
+TrackingStats tracking_stats(const core::AxisTrace& axis) {
+  TrackingStats s;
+  double sum = 0.0;
+  for (std::size_t k = 0; k < axis.cmd.size(); ++k) {
+    const double e = axis.cmd[k] - axis.act[k];
+    sum += e * e;
+    s.max = std::max(s.max, std::abs(e));
+  }
+  s.rms = axis.cmd.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(axis.cmd.size()));
+  return s;
+}
+
+}  // namespace servotwin::vcnc

@@ -1,0 +1,160 @@
+// `servotwin identify`: captures -> closed-loop axis model (thesis chapters 3 and 4).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "capture_input.hpp"
+#include "command.hpp"
+#include "model_summary.hpp"
+#include "servotwin/io/rapid_json.hpp"
+#include "solver_options.hpp"
+#include "servotwin/core/error.hpp"
+
+namespace servotwin::cli {
+
+namespace {
+
+struct IdentifyArgs {
+  std::vector<std::string> captures;
+  std::vector<std::string> validate;
+  std::vector<std::string> axes;
+  CaptureInput reading;
+  SolverInput solver;
+  std::string shift = "auto";
+  double trim_start_s = 0.0, trim_end_s = 0.0, deadband = 0.0;
+  CLI::Option* deadband_opt = nullptr;
+  std::string output, stats_output;
+};
+
+/// "model.json" for one axis; several axes need "{axis}" in the name.
+std::string output_for(const std::string& pattern, const std::string& axis, std::size_t axis_count, const char* option) {
+  const auto at = pattern.find("{axis}");
+  if (at == std::string::npos) {
+    if (axis_count > 1)
+      throw core::InputError({pattern, 0, 0, option},
+                             "several axes are identified: put {axis} in the file name, e.g. model_{axis}.json");
+    return pattern;
+  }
+  return pattern.substr(0, at) + axis + pattern.substr(at + 6);
+}
+
+bool command_moves(const core::AxisTrace& trace) {
+  const auto [lo, hi] = std::minmax_element(trace.cmd.begin(), trace.cmd.end());
+  return lo != trace.cmd.end() && *lo != *hi;
+}
+
+/// --axis as given, else every axis whose command moves in some capture (a 3-axis capture of a
+/// one-axis program holds two axes at rest, which are skipped with a note).
+std::vector<std::string> axes_to_identify(const IdentifyArgs& a, const std::vector<vcnc::NamedCapture>& captures,
+                                          const GlobalOptions& global) {
+  if (!a.axes.empty()) return a.axes;
+  std::vector<std::string> names;
+  for (const auto& axis : captures.front().capture.axes) {
+    const bool moves = std::any_of(captures.begin(), captures.end(), [&](const vcnc::NamedCapture& c) {
+      const core::AxisTrace* t = c.capture.find(axis.name);
+      return t != nullptr && command_moves(*t);
+    });
+    if (moves) names.push_back(axis.name);
+    else progress(global, "axis {}: the command never moves, skipped", axis.name);
+  }
+  if (names.empty()) {
+    throw core::InputError({captures.front().source, 0, 0, "x_cmd"},
+                           "no axis's command moves: nothing to identify (capture an identification program, see "
+                           "`servotwin gcode identification`)");
+  }
+  return names;
+}
+
+/// "--shift auto" searches -3..3 samples; a number fixes the shift.
+void apply_shift(const std::string& text, vcnc::IdentificationSettings& settings) {
+  if (text == "auto") {
+    settings.shift_search = vcnc::ShiftSearch{};
+    return;
+  }
+  std::size_t used = 0;
+  int value = 0;
+  try {
+    value = std::stoi(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || text.empty()) {
+    throw core::InputError({"", 0, 0, "--shift"}, "expected 'auto' or a whole number of samples, got '" + text + "'");
+  }
+  settings.regressors.command_shift = value;
+}
+
+int run(const IdentifyArgs& a, const GlobalOptions& global) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<vcnc::NamedCapture> captures = read_captures(a.captures, a.reading);
+  const std::vector<vcnc::NamedCapture> validation = read_captures(a.validate, a.reading);
+  progress(global, "read {} capture(s){} in {:.1f} ms", captures.size(),
+           validation.empty() ? "" : fmt::format(" and {} validation capture(s)", validation.size()), elapsed_ms(start));
+
+  vcnc::IdentificationSettings settings;
+  apply_solver_input(a.solver, settings);
+  const double ts = captures.front().capture.ts;
+  apply_shift(a.shift, settings);
+  settings.regressors.trim_start = static_cast<std::size_t>(std::llround(a.trim_start_s / ts));
+  settings.regressors.trim_end = static_cast<std::size_t>(std::llround(a.trim_end_s / ts));
+  if (a.deadband_opt->count() > 0) settings.regressors.velocity_deadband = a.deadband;
+
+  const std::vector<std::string> axes = axes_to_identify(a, captures, global);
+  for (const auto& axis : axes) {
+    vcnc::AxisIdentification record = vcnc::identify_axis(captures, validation, axis, settings);
+    record.length_unit = a.reading.scale == 1.0 ? "as in the file" : fmt::format("file unit x {}", a.reading.scale);
+    print_model_summary(record);
+    if (!a.stats_output.empty()) {
+      std::vector<std::string> warnings;
+      const auto problem = vcnc::axis_problem(captures, axis, record.regressors, warnings);
+      auto out = open_output(output_for(a.stats_output, axis, axes.size(), "--stats-out"), global);
+      out->stream() << io::normal_equations_to_json(problem.normal_equations(), axis, a.captures,
+                                                    record.regressors.command_shift)
+                           .dump(2)
+                    << '\n';
+      out->commit();
+    }
+    if (!a.output.empty()) {
+      auto out = open_output(output_for(a.output, axis, axes.size(), "-o"), global);
+      out->stream() << io::axis_model_to_json(record).dump(2) << '\n';
+      out->commit();
+      progress(global, "wrote {}", out->path());
+    }
+  }
+  progress(global, "identified {} axis(es) in {:.1f} ms", axes.size(), elapsed_ms(start));
+  return kSuccess;
+}
+
+}  // namespace
+
+void register_identify(CLI::App& app, Action& selected) {
+  auto a = std::make_shared<IdentifyArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "identify", "Identify the closed-loop axis model (thesis Eq. 3.3) from captures of commanded and actual position");
+  cmd->add_option("captures", a->captures, "Capture CSV files; several are concatenated (e.g. low- and high-speed runs)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--axis", a->axes, "Axes to identify (default: every axis whose command moves)");
+  add_solver_options(*cmd, a->solver);
+  cmd->add_option("--shift", a->shift,
+                  "Command shift in samples (x_r,k := cmd[k + shift]: a controller's preview, negative for a delay), or "
+                  "'auto': the shift in -3..3 whose model fits the identification data best")
+      ->capture_default_str();
+  cmd->add_option("--trim-start", a->trim_start_s, "Seconds dropped at the start of each capture")->capture_default_str();
+  cmd->add_option("--trim-end", a->trim_end_s, "Seconds dropped at the end of each capture")->capture_default_str();
+  a->deadband_opt = cmd->add_option("--deadband", a->deadband,
+                                    "Velocity deadband of the direction indicators [length/s] (default: from the data)");
+  add_capture_input_options(*cmd, a->reading);
+  cmd->add_option("--validate", a->validate, "Validation captures: the model's simulated tracking error is scored on them")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", a->output, "Model file (servotwin.axis-model/1); {axis} in the name for several axes");
+  cmd->add_option("--stats-out", a->stats_output, "Write the sufficient statistics (servotwin.normal-equations/1)");
+  set_examples(*cmd,
+               "  servotwin identify capture.csv --axis x --method exact -o model.json --stats-out stats.json\n"
+               "  servotwin identify DATA_EMPS.csv --map x_cmd=qg --map x_act=qm --scale 1000 --validate other.csv -o model.json\n"
+               "  servotwin identify low.csv high.csv --method ga --seed 3 -o model_{axis}.json\n");
+  cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });
+}
+
+}  // namespace servotwin::cli

@@ -1,0 +1,60 @@
+#include "model_summary.hpp"
+
+#include <cmath>
+#include <fmt/core.h>
+#include <numbers>
+
+namespace servotwin::cli {
+
+namespace {
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+std::string root_text(const core::ModalInfo& m) {
+  if (!std::isfinite(m.freq_hz)) return "at infinity";
+  if (m.root.imag() != 0.0) return fmt::format("{:.2f} Hz, zeta {:.3f}", m.freq_hz, m.zeta);
+  return fmt::format("{:.2f} Hz real{}", m.freq_hz, m.root.real() > 0.0 ? " (UNSTABLE)" : "");
+}
+}  // namespace
+
+void print_roots(const char* label, const std::vector<core::ModalInfo>& roots) {
+  fmt::print("  {}:", label);
+  if (roots.empty()) fmt::print(" none");
+  for (const auto& m : roots)
+    if (m.root.imag() >= 0.0) fmt::print(" [{}]", root_text(m));
+  fmt::print("\n");
+}
+
+void print_model_summary(const vcnc::AxisIdentification& r) {
+  const auto& s = r.solution;
+  const auto& c = s.coefficients;
+  const rapid::AxisModel model(c, r.ts);
+  fmt::print("axis {}: method {}, objective {:.6g}{} ({:.2f} ms){}\n", r.axis, rapid::method_name(s.method), s.objective,
+             std::isfinite(s.lower_bound) && s.method == rapid::Method::Exact
+                 ? fmt::format(", certified lower bound {:.6g}", s.lower_bound)
+                 : std::string(),
+             s.time_ms, s.feasible ? "" : "  [outside the bounds]");
+  fmt::print("  a1 = {:.6g}  a2 = {:.6g}  a3 = {:.6g}\n  b0 = {:.6g}  b1 = {:.6g}  b2 = {:.6g}\n  d0 = {:.6g}  d1 = {:.6g}\n",
+             c.a1, c.a2, c.a3, c.b0, c.b1, c.b2, c.d0, c.d1);
+  fmt::print("  search: wn {:.3f} Hz, zeta {:.4f}, p {:.3f} Hz; {}\n", s.wn / kTwoPi, s.zeta, s.p / kTwoPi,
+             s.kkt_case.empty() ? "" : "case " + s.kkt_case);
+  for (const auto& a : s.active) fmt::print("  active bound {} (multiplier {:.4g})\n", a.name, a.multiplier);
+  print_roots("poles", model.poles());
+  print_roots("zeros", model.zeros());
+  fmt::print("  {}; tracking bandwidth {:.2f} Hz\n", model.is_stable() ? "stable" : "UNSTABLE", model.bandwidth_hz());
+  if (!r.shift_trials.empty()) {
+    fmt::print("  command shift {} samples, chosen by fit from:", r.regressors.command_shift);
+    for (const auto& t : r.shift_trials) fmt::print(" {}:{:.4f}{}", t.shift, t.nrmse, t.stable ? "" : "(unstable)");
+    fmt::print("\n");
+  } else if (r.regressors.command_shift != 0) {
+    fmt::print("  command shift {} samples\n", r.regressors.command_shift);
+  }
+  if (r.fit)
+    fmt::print("  fit (simulated tracking error): rms {:.4g} of {:.4g} {}, nrmse {:.4f}\n", r.fit->rms_difference,
+               r.fit->rms_measured, r.length_unit, r.fit->nrmse);
+  if (r.validation)
+    fmt::print("  validation: rms {:.4g} of {:.4g} {}, nrmse {:.4f}\n", r.validation->rms_difference,
+               r.validation->rms_measured, r.length_unit, r.validation->nrmse);
+  for (const auto& w : s.warnings) fmt::print("  warning: {}\n", w);
+}
+
+}  // namespace servotwin::cli

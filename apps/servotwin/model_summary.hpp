@@ -1,0 +1,14 @@
+#pragma once
+// Human-readable summary of an identified axis model, shared by `identify` and `solve`.
+
+#include "servotwin/vcnc/identification.hpp"
+
+namespace servotwin::cli {
+
+/// Coefficients, search variables, active bounds, poles, zeros, bandwidth and fit on stdout.
+/// "  label: [1.40 Hz real] [37.51 Hz, zeta 0.431]" (one line; conjugates once).
+void print_roots(const char* label, const std::vector<core::ModalInfo>& roots);
+
+void print_model_summary(const vcnc::AxisIdentification& identification);
+
+}  // namespace servotwin::cli

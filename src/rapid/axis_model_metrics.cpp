@@ -1,0 +1,112 @@
+// Simulation-based fit quality (the issue: the model is judged by simulating it, not by its
+// one-step prediction).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "servotwin/core/error.hpp"
+#include "servotwin/rapid/axis_model.hpp"
+
+namespace servotwin::rapid {
+
+namespace {
+
+core::SourceLocation field(std::string name) {
+  core::SourceLocation where;
+  where.field = std::move(name);
+  return where;
+}
+
+void require_finite(std::span<const double> values, const char* name) {
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    if (!std::isfinite(values[k])) {
+      throw core::InputError(field(std::string(name) + "[" + std::to_string(k) + "]"),
+                             "tracking error sample must be finite (an unstable model's prediction diverges)");
+    }
+  }
+}
+
+// sqrt(sum v_k^2) with the scaling of BLAS dnrm2, so that squares of large errors cannot overflow.
+class Norm {
+ public:
+  void add(double v) {
+    const double a = std::abs(v);
+    if (a == 0.0) return;
+    if (a > scale_) {
+      sum_ = 1.0 + sum_ * (scale_ / a) * (scale_ / a);
+      scale_ = a;
+    } else {
+      sum_ += (a / scale_) * (a / scale_);
+    }
+  }
+  [[nodiscard]] double value() const { return scale_ * std::sqrt(sum_); }
+
+ private:
+  double scale_ = 0.0, sum_ = 0.0;
+};
+
+}  // namespace
+
+FitMetrics compare_tracking(std::span<const double> measured_error, std::span<const double> predicted_error) {
+  if (measured_error.size() != predicted_error.size()) {
+    throw core::InputError(field("predicted_error"), "length " + std::to_string(predicted_error.size()) +
+                                                         " differs from the measured error's " +
+                                                         std::to_string(measured_error.size()));
+  }
+  if (measured_error.empty()) throw core::InputError(field("measured_error"), "at least one sample is required");
+  require_finite(measured_error, "measured_error");
+  require_finite(predicted_error, "predicted_error");
+
+  const std::size_t n = measured_error.size();
+  const double count = static_cast<double>(n);
+  double mean = 0.0;
+  for (const double e : measured_error) mean += e;
+  mean /= count;
+  const auto [min_it, max_it] = std::minmax_element(measured_error.begin(), measured_error.end());
+  const bool constant = *min_it == *max_it;
+
+  Norm measured, predicted, difference, deviation;
+  FitMetrics m;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double d = measured_error[k] - predicted_error[k];
+    measured.add(measured_error[k]);
+    predicted.add(predicted_error[k]);
+    difference.add(d);
+    deviation.add(measured_error[k] - mean);
+    m.max_difference = std::max(m.max_difference, std::abs(d));
+  }
+  const double root_n = std::sqrt(count);
+  m.samples = n;
+  m.rms_measured = measured.value() / root_n;
+  m.rms_predicted = predicted.value() / root_n;
+  m.rms_difference = difference.value() / root_n;
+  if (constant) {
+    m.nrmse = difference.value() == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();
+  } else {
+    m.nrmse = difference.value() / deviation.value();
+  }
+  m.fit_percent = 100.0 * (1.0 - m.nrmse);
+  return m;
+}
+
+FitMetrics simulation_fit(const AxisModel& model, std::span<const double> command, std::span<const double> actual,
+                          const ModelSimulationOptions& options) {
+  if (command.size() != actual.size()) {
+    throw core::InputError(field("actual"), "length " + std::to_string(actual.size()) + " differs from the command's " +
+                                                std::to_string(command.size()));
+  }
+  if (command.empty()) throw core::InputError(field("command"), "at least one sample is required");
+  for (std::size_t k = 0; k < actual.size(); ++k) {
+    if (!std::isfinite(actual[k]))
+      throw core::InputError(field("actual[" + std::to_string(k) + "]"), "actual position sample must be finite");
+  }
+  ModelSimulationOptions opts = options;
+  if (!opts.initial_position) opts.initial_position = actual.front();
+  const ModelResponse response = model.simulate(command, opts);
+  std::vector<double> measured(command.size());
+  for (std::size_t k = 0; k < command.size(); ++k) measured[k] = command[k] - actual[k];
+  return compare_tracking(measured, response.tracking_error);
+}
+
+}  // namespace servotwin::rapid

@@ -1,0 +1,177 @@
+#include "servotwin/vcnc/identification.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <limits>
+
+#include "servotwin/core/error.hpp"
+
+namespace servotwin::vcnc {
+
+namespace {
+
+const core::AxisTrace& require_axis(const NamedCapture& c, const std::string& axis) {
+  const core::AxisTrace* trace = c.capture.find(axis);
+  if (trace == nullptr) {
+    std::string names;
+    for (const auto& a : c.capture.axes) names += (names.empty() ? "" : ", ") + a.name;
+    throw core::InputError({c.source, 0, 0, "--axis"}, "no axis '" + axis + "' in this capture (axes: " + names + ")");
+  }
+  return *trace;
+}
+
+}  // namespace
+
+rapid::Bounds complete_bounds(rapid::Bounds bounds, double ts) {
+  const rapid::Bounds d = rapid::default_bounds(ts);
+  if (bounds.p_min == 0.0) bounds.p_min = d.p_min;
+  if (bounds.p_max == 0.0) bounds.p_max = d.p_max;
+  if (bounds.wn_min == 0.0) bounds.wn_min = d.wn_min;
+  if (bounds.wn_max == 0.0) bounds.wn_max = d.wn_max;
+  rapid::validate(bounds);
+  return bounds;
+}
+
+rapid::RegressionProblem axis_problem(const std::vector<NamedCapture>& captures, const std::string& axis,
+                                      const rapid::RegressorOptions& options, std::vector<std::string>& warnings) {
+  rapid::RegressionProblem total;
+  double command_range = 0.0, actual_range = 0.0;
+  for (const auto& c : captures) {
+    const core::AxisTrace& trace = require_axis(c, axis);
+    rapid::RegressionDiagnostics diagnostics;
+    rapid::RegressionProblem one;
+    try {
+      one = rapid::build_problem(trace.cmd, trace.act, c.capture.ts, options, &diagnostics);
+    } catch (const core::InputError& e) {
+      throw core::InputError({c.source, 0, 0, e.where().field}, e.reason());
+    }
+    for (const auto& w : diagnostics.warnings) warnings.push_back(c.source + ": " + w);
+    command_range = std::max(command_range, diagnostics.command_range);
+    actual_range = std::max(actual_range, diagnostics.actual_range);
+    if (total.empty()) {
+      total = one;
+      continue;
+    }
+    try {
+      total.merge(one);
+    } catch (const core::InputError& e) {
+      throw core::InputError({c.source, 0, 0, "t"}, e.reason());
+    }
+  }
+  // A model fitted to no motion would be all noise: refuse rather than write it.
+  const std::string names = captures.size() == 1 ? captures.front().source : std::to_string(captures.size()) + " captures";
+  if (command_range == 0.0) {
+    throw core::InputError({names, 0, 0, axis + "_cmd"}, "the command of axis '" + axis +
+                                                           "' never moves: nothing to identify (capture an identification program, "
+                                                           "see `servotwin gcode identification`)");
+  }
+  if (actual_range == 0.0) {
+    throw core::InputError({names, 0, 0, axis + "_act"},
+                           "the actual position of axis '" + axis + "' never changes although the command moves: is the "
+                                                                    "right column mapped (--map " + axis + "_act=...)?");
+  }
+  return total;
+}
+
+rapid::FitMetrics simulated_fit(const rapid::AxisModel& model, const std::vector<NamedCapture>& captures,
+                                const std::string& axis, int command_shift) {
+  if (captures.size() == 1) {
+    const core::AxisTrace& trace = require_axis(captures.front(), axis);
+    rapid::ModelSimulationOptions options;
+    options.command_shift = command_shift;
+    return rapid::simulation_fit(model, trace.cmd, trace.act, options);
+  }
+  std::size_t total = 0;
+  for (const auto& c : captures) total += require_axis(c, axis).cmd.size();
+  std::vector<double> measured, predicted;
+  measured.reserve(total);
+  predicted.reserve(total);
+  rapid::ModelSimulationOptions options;
+  options.command_shift = command_shift;
+  for (const auto& c : captures) {
+    const core::AxisTrace& trace = require_axis(c, axis);
+    options.initial_position = trace.act.front();
+    const rapid::ModelResponse response = model.simulate(trace.cmd, options);
+    for (std::size_t k = 0; k < trace.cmd.size(); ++k) measured.push_back(trace.cmd[k] - trace.act[k]);
+    predicted.insert(predicted.end(), response.tracking_error.begin(), response.tracking_error.end());
+  }
+  return rapid::compare_tracking(measured, predicted);
+}
+
+namespace {
+
+/// Identification with the shift in settings.regressors.
+AxisIdentification identify_with_shift(const std::vector<NamedCapture>& captures, const std::string& axis,
+                                       const IdentificationSettings& settings, const rapid::Bounds& bounds) {
+  AxisIdentification result;
+  result.axis = axis;
+  result.ts = captures.front().capture.ts;
+  result.bounds = bounds;
+  result.regressors = settings.regressors;
+  std::vector<std::string> warnings;
+  const rapid::RegressionProblem problem = axis_problem(captures, axis, settings.regressors, warnings);
+  result.solution = rapid::solve(problem, settings.method, result.bounds, settings.solve);
+  result.solution.warnings.insert(result.solution.warnings.begin(), warnings.begin(), warnings.end());
+  const rapid::AxisModel model(result.solution.coefficients, result.ts);
+  result.fit = simulated_fit(model, captures, axis, settings.regressors.command_shift);
+  return result;
+}
+
+/// Index of the candidate to keep: a stable model before an unstable one; among the stable ones
+/// whose fit is within kShiftFitTolerance of the best, the smallest |shift| (a shift should only
+/// be used when the data ask for it clearly, not to fit noise).
+std::size_t choose_shift(const std::vector<ShiftTrial>& trials) {
+  constexpr double kShiftFitTolerance = 0.02;
+  const bool any_stable = std::any_of(trials.begin(), trials.end(), [](const ShiftTrial& t) { return t.stable; });
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& t : trials)
+    if (t.stable == any_stable) best = std::min(best, t.nrmse);
+  std::size_t chosen = trials.size();
+  for (std::size_t i = 0; i < trials.size(); ++i) {
+    const ShiftTrial& t = trials[i];
+    if (t.stable != any_stable || !(t.nrmse <= best * (1.0 + kShiftFitTolerance))) continue;
+    if (chosen == trials.size() || std::abs(t.shift) < std::abs(trials[chosen].shift) ||
+        (std::abs(t.shift) == std::abs(trials[chosen].shift) && t.nrmse < trials[chosen].nrmse)) {
+      chosen = i;
+    }
+  }
+  return chosen == trials.size() ? 0 : chosen;
+}
+
+}  // namespace
+
+AxisIdentification identify_axis(const std::vector<NamedCapture>& captures, const std::vector<NamedCapture>& validation,
+                                 const std::string& axis, const IdentificationSettings& settings) {
+  if (captures.empty()) throw core::InputError("no captures to identify from");
+  const rapid::Bounds bounds = complete_bounds(settings.bounds, captures.front().capture.ts);
+  AxisIdentification result;
+  if (settings.shift_search) {
+    const ShiftSearch range = *settings.shift_search;
+    if (range.first > range.last || range.last - range.first > 64) {
+      throw core::InputError({"", 0, 0, "--shift"}, "shift search range " + std::to_string(range.first) + ".." +
+                                                        std::to_string(range.last) +
+                                                        " must be ascending and at most 64 samples wide");
+    }
+    std::vector<ShiftTrial> trials;
+    std::vector<AxisIdentification> candidates;
+    IdentificationSettings one = settings;
+    for (int shift = range.first; shift <= range.last; ++shift) {
+      one.regressors.command_shift = shift;
+      candidates.push_back(identify_with_shift(captures, axis, one, bounds));
+      const AxisIdentification& c = candidates.back();
+      trials.push_back({shift, c.fit->nrmse, rapid::AxisModel(c.solution.coefficients, c.ts).is_stable()});
+    }
+    result = std::move(candidates[choose_shift(trials)]);
+    result.shift_trials = std::move(trials);
+  } else {
+    result = identify_with_shift(captures, axis, settings, bounds);
+  }
+  if (!validation.empty()) {
+    const rapid::AxisModel model(result.solution.coefficients, result.ts);
+    result.validation = simulated_fit(model, validation, axis, result.regressors.command_shift);
+  }
+  for (const auto& c : captures) result.sources.push_back(c.source);
+  return result;
+}
+
+}  // namespace servotwin::vcnc

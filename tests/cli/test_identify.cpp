@@ -1,0 +1,190 @@
+// End-to-end tests of `servotwin identify`, `solve` and `model` (issue forms), the model and
+// statistics files, and bad input: exit status 3 with a message naming the file and field, and
+// nothing written.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_support.hpp"
+
+namespace {
+
+using servotwin::cli_test::Cli;
+using servotwin::cli_test::slurp;
+using ::testing::HasSubstr;
+using json = nlohmann::json;
+
+class Identify : public Cli {
+ protected:
+  /// A Table 3.2-style capture of the PID preset (thesis section 4.3.1).
+  void capture(const std::string& name, const std::string& machine = "fadal-pid", int seed = 7) const {
+    ASSERT_EQ(run("gcode identification --axis X --seed " + std::to_string(seed) + " -o " + name + ".nc").status, 0);
+    ASSERT_EQ(run("capture --machine " + machine + " --program " + name + ".nc -o " + name + ".csv").status, 0);
+  }
+  [[nodiscard]] json read_json(const std::string& name) const { return json::parse(slurp(path(name))); }
+};
+
+TEST_F(Identify, IssueCommandFormsProduceTheDocumentedFiles) {
+  capture("capture");
+  const auto r = run("identify capture.csv --axis x --method exact -o model.json --stats-out stats.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("method exact"));
+  EXPECT_THAT(r.out, HasSubstr("stable"));
+
+  const json m = read_json("model.json");
+  EXPECT_EQ(m["format"], "servotwin.axis-model/1");
+  for (const char* k : {"a1", "a2", "a3", "b0", "b1", "b2", "d0", "d1"}) EXPECT_TRUE(m["model"][k].is_number()) << k;
+  for (const char* k : {"wn_hz", "zeta", "p_hz"}) EXPECT_TRUE(m["search"][k].is_number()) << k;
+  ASSERT_EQ(m["poles"].size(), 3u);
+  EXPECT_TRUE(m["poles"][0]["hz"].is_number());
+  EXPECT_TRUE(m["zeros"].is_array());
+  EXPECT_DOUBLE_EQ(m["bounds"]["p_min_hz"].get<double>(), 0.2);
+  EXPECT_DOUBLE_EQ(m["bounds"]["wn_max_hz"].get<double>(), 500.0);  // Nyquist of 1 kHz
+  EXPECT_TRUE(m["active_constraints"].is_array());
+  EXPECT_GT(m["objective"].get<double>(), 0.0);
+  EXPECT_LT(m["fit"]["nrmse"].get<double>(), 0.05);
+  EXPECT_EQ(m["solver"]["method"], "exact");
+  EXPECT_TRUE(m["solver"].contains("seed"));
+  EXPECT_TRUE(m["solver"]["time_ms"].is_number());
+  EXPECT_EQ(m["shift_search"].size(), 7u);
+  EXPECT_TRUE(m["stable"].get<bool>());
+
+  const json s = read_json("stats.json");
+  EXPECT_EQ(s["format"], "servotwin.normal-equations/1");
+  EXPECT_EQ(s["regressors"], json({"e_i", "-xdot", "-xddot", "x_r", "xdot_r", "xddot_r", "-PV", "-NV"}));
+  ASSERT_EQ(s["P"].size(), 8u);
+  EXPECT_EQ(s["P"][7].size(), 8u);
+  EXPECT_EQ(s["R"].size(), 8u);
+  EXPECT_GT(s["Gamma"].get<double>(), 0.0);
+  EXPECT_GT(s["N"].get<double>(), 20000.0);  // a 22 s capture at 1 kHz
+  EXPECT_DOUBLE_EQ(s["Ts"].get<double>(), 0.001);
+  EXPECT_EQ(s["command_shift"], m["regressors"]["command_shift"]);
+
+  // The statistics alone give the same model (same shift, same solver).
+  ASSERT_EQ(run("solve stats.json --method exact -o solved.json").status, 0);
+  const json solved = read_json("solved.json");
+  for (const char* k : {"a1", "a2", "a3", "b0", "b1", "b2", "d0", "d1"}) {
+    const double a = m["model"][k], b = solved["model"][k];
+    EXPECT_NEAR(a, b, 1e-6 * std::abs(a)) << k;
+  }
+  EXPECT_EQ(solved["regressors"]["command_shift"], m["regressors"]["command_shift"]);
+
+  // The genetic algorithm and least squares from the same statistics.
+  ASSERT_EQ(run("solve stats.json --method ga --seed 3 --generations 40 --population 500 -o ga.json").status, 0);
+  const json ga = read_json("ga.json");
+  EXPECT_EQ(ga["solver"]["seed"], 3);
+  EXPECT_EQ(ga["solver"]["history"]["rows"].size(), 40u);
+  EXPECT_GE(ga["objective"].get<double>(), m["objective"].get<double>() * (1.0 - 1e-9));
+  ASSERT_EQ(run("solve stats.json --method ls -o ls.json").status, 0);
+  EXPECT_LE(read_json("ls.json")["objective"].get<double>(), m["objective"].get<double>() * (1.0 + 1e-9));
+
+  // Frequency responses.
+  const auto f = run("model model.json --frf frf.csv --points 50");
+  ASSERT_EQ(f.status, 0) << f.err;
+  EXPECT_THAT(f.out, HasSubstr("poles"));
+  const std::string csv = slurp(path("frf.csv"));
+  EXPECT_THAT(csv, testing::StartsWith("freq_hz,tracking_re,tracking_im,tracking_mag_db,tracking_phase_deg,"));
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 51);
+}
+
+TEST_F(Identify, StatisticsOfSeveralRunsAddUp) {
+  capture("a", "fadal-pid", 7);
+  capture("b", "fadal-pid", 8);
+  ASSERT_EQ(run("identify a.csv b.csv --shift 0 -o both.json").status, 0);
+  ASSERT_EQ(run("identify a.csv --shift 0 --stats-out a.json").status, 0);
+  ASSERT_EQ(run("identify b.csv --shift 0 --stats-out b.json").status, 0);
+  ASSERT_EQ(run("solve a.json b.json -o sum.json").status, 0);
+  const double joint = read_json("both.json")["objective"], sum = read_json("sum.json")["objective"];
+  EXPECT_NEAR(joint, sum, 1e-9 * joint);
+  // Statistics built with another shift do not add up.
+  ASSERT_EQ(run("identify b.csv --shift 2 --stats-out b2.json").status, 0);
+  const auto r = run("solve a.json b2.json -o never.json");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("b2.json"));
+  EXPECT_THAT(r.err, HasSubstr("command_shift"));
+  EXPECT_FALSE(std::filesystem::exists(path("never.json")));
+}
+
+TEST_F(Identify, MeasuredEmpsAxisWithValidation) {
+  const std::string dir = SERVOTWIN_REPO_DATA_DIR "/emps/";
+  const auto r = run("identify '" + dir + "DATA_EMPS.csv' --map x_cmd=qg --map x_act=qm --scale 1000 --validate '" + dir +
+                     "DATA_EMPS_PULSES.csv' -o model.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json m = read_json("model.json");
+  EXPECT_TRUE(m["stable"].get<bool>());
+  EXPECT_EQ(m["active_constraints"][0]["name"], "p_min");  // least squares puts p in the right half plane
+  EXPECT_LT(m["validation"]["nrmse"].get<double>(), 0.25);
+  EXPECT_EQ(m["kkt_case"], "5: p = p_min");
+}
+
+TEST_F(Identify, BadInputIsReportedAndNothingIsWritten) {
+  write("short.csv", "t,x_cmd,x_act\n0,0,0\n0.001,1,0\n0.002,2,1\n");
+  auto r = run("identify short.csv -o m.json");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("short.csv"));
+  EXPECT_THAT(r.err, HasSubstr("too short"));
+
+  std::string still = "t,x_cmd,x_act\n";
+  for (int k = 0; k < 3000; ++k) still += std::to_string(k * 0.001) + ",1.5,1.5\n";
+  write("still.csv", still);
+  r = run("identify still.csv -o m.json");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("never moves"));
+
+  std::string nan = "t,x_cmd,x_act\n";
+  for (int k = 0; k < 3000; ++k) nan += std::to_string(k * 0.001) + "," + std::to_string(k * 0.01) + "," + (k == 100 ? "nan" : "0") + "\n";
+  write("nan.csv", nan);
+  r = run("identify nan.csv -o m.json");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("nan.csv:102:"));
+
+  capture("capture");
+  r = run("identify capture.csv --wn-min-hz 50 --wn-max-hz 10 -o m.json");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("bounds.wn_max"));
+  r = run("identify capture.csv --shift soon -o m.json");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("--shift"));
+  r = run("identify capture.csv --axis q -o m.json");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("no axis 'q'"));
+  EXPECT_FALSE(std::filesystem::exists(path("m.json")));
+
+  // Statistics that do not match: another sample period.
+  ASSERT_EQ(run("identify capture.csv --stats-out s.json").status, 0);
+  json other = read_json("s.json");
+  other["Ts"] = 0.002;
+  write("other.json", other.dump());
+  r = run("solve s.json other.json -o m.json");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("other.json"));
+  json broken = read_json("s.json");
+  broken["regressors"][3] = "x";
+  write("broken.json", broken.dump());
+  r = run("solve broken.json");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("regressors[3]"));
+
+  // An existing file is not overwritten without --force.
+  write("keep.json", "mine");
+  r = run("identify capture.csv -o keep.json");
+  EXPECT_NE(r.status, 0);
+  EXPECT_EQ(slurp(path("keep.json")), "mine");
+}
+
+TEST_F(Identify, FrictionWithoutReversalsIsReported) {
+  // A capture that only ever moves forward: delta- cannot be identified, and the tool says so.
+  std::string ramp = "t,x_cmd,x_act\n";
+  for (int k = 0; k < 4000; ++k) {
+    const double t = k * 0.001, x = t < 1.0 ? 10.0 * t * t : 10.0 + 20.0 * (t - 1.0);
+    ramp += std::to_string(t) + "," + std::to_string(x) + "," + std::to_string(x - 0.01 * std::min(t, 1.0) + 0.001 * std::sin(40 * t)) + "\n";
+  }
+  write("ramp.csv", ramp);
+  const auto r = run("identify ramp.csv -o m.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("no motion in the negative direction"));
+  EXPECT_THAT(read_json("m.json")["warnings"].dump(), HasSubstr("delta- not identifiable"));
+}
+
+}  // namespace

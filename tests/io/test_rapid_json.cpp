@@ -1,0 +1,165 @@
+// Statistics and model files of rapid identification: exact round trips, adding files up, and
+// errors that name the file and field.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "servotwin/core/error.hpp"
+#include "servotwin/io/rapid_json.hpp"
+
+namespace {
+
+using servotwin::core::InputError;
+using ::testing::HasSubstr;
+namespace rapid = servotwin::rapid;
+namespace io = servotwin::io;
+
+// A well-posed problem: 8 regressors of a small synthetic data set (the numbers themselves are
+// arbitrary; the tests check exact transport, not identification).
+rapid::NormalEquations sample_equations(double ts = 0.001) {
+  Eigen::Matrix<double, 40, 9> data;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 9; ++j) data(i, j) = std::sin(0.37 * i * (j + 1) + 0.1 * j) + (i == j ? 2.0 : 0.0);
+  const Eigen::Matrix<double, 40, 8> phi = data.leftCols<8>();
+  const Eigen::Matrix<double, 40, 1> y = data.col(8);
+  rapid::NormalEquations ne;
+  ne.P = phi.transpose() * phi;
+  ne.R = phi.transpose() * y;
+  ne.gamma = y.squaredNorm();
+  ne.n = 40;
+  ne.ts = ts;
+  return ne;
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    io::parse_normal_equations_json(text, "s.json");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(RapidJson, NormalEquationsRoundTripExactlyInTheIssuesShape) {
+  const rapid::NormalEquations ne = sample_equations();
+  const nlohmann::json j = io::normal_equations_to_json(ne, "x", {"capture.csv"});
+  EXPECT_EQ(j["format"], "servotwin.normal-equations/1");
+  EXPECT_EQ(j["regressors"], nlohmann::json({"e_i", "-xdot", "-xddot", "x_r", "xdot_r", "xddot_r", "-PV", "-NV"}));
+  EXPECT_EQ(j["P"].size(), 8U);
+  EXPECT_EQ(j["P"][0].size(), 8U);
+  std::string axis;
+  const rapid::NormalEquations back = io::parse_normal_equations_json(j.dump(), "s.json", &axis);
+  EXPECT_EQ(axis, "x");
+  EXPECT_EQ(back.P, ne.P);
+  EXPECT_EQ(back.R, ne.R);
+  EXPECT_EQ(back.gamma, ne.gamma);
+  EXPECT_EQ(back.n, ne.n);
+  EXPECT_EQ(back.ts, ne.ts);
+}
+
+TEST(RapidJson, StatisticsFilesAddUp) {
+  const auto dir = std::filesystem::temp_directory_path() / ("servotwin-stats-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const rapid::NormalEquations a = sample_equations();
+  rapid::NormalEquations b = sample_equations();
+  b.P *= 2.0;
+  b.R *= 2.0;
+  b.gamma *= 2.0;
+  std::ofstream(dir / "a.json") << io::normal_equations_to_json(a, "x").dump();
+  std::ofstream(dir / "b.json") << io::normal_equations_to_json(b, "x").dump();
+  const io::LoadedStatistics sum = io::load_statistics({(dir / "a.json").string(), (dir / "b.json").string()});
+  const rapid::NormalEquations total = sum.problem.normal_equations();
+  EXPECT_EQ(sum.axis, "x");
+  EXPECT_EQ(total.n, 80U);
+  // Sum of the two: 3x the first (relative rounding of the factor round trip).
+  EXPECT_LT((total.P - 3.0 * a.P).norm(), 1e-11 * a.P.norm());
+  EXPECT_LT((total.R - 3.0 * a.R).norm(), 1e-11 * a.R.norm());
+  EXPECT_NEAR(total.gamma, 3.0 * a.gamma, 1e-11 * a.gamma);
+
+  std::ofstream(dir / "c.json") << io::normal_equations_to_json(sample_equations(0.002), "x").dump();
+  try {
+    io::load_statistics({(dir / "a.json").string(), (dir / "c.json").string()});
+    ADD_FAILURE() << "different Ts accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("c.json"));
+  }
+  std::ofstream(dir / "y.json") << io::normal_equations_to_json(a, "y").dump();
+  try {
+    io::load_statistics({(dir / "a.json").string(), (dir / "y.json").string()});
+    ADD_FAILURE() << "different axes accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("axis 'y'"));
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(RapidJson, StatisticsErrorsNameTheField) {
+  nlohmann::json j = io::normal_equations_to_json(sample_equations());
+  auto broken = j;
+  broken["regressors"][3] = "xr";
+  EXPECT_THAT(error_of(broken.dump()), HasSubstr("s.json (regressors[3]): expected \"x_r\""));
+  broken = j;
+  broken["P"][2].erase(1);
+  EXPECT_THAT(error_of(broken.dump()), HasSubstr("(P[2]): expected an array of 8 elements"));
+  broken = j;
+  broken["P"][2][5] = "x";
+  EXPECT_THAT(error_of(broken.dump()), HasSubstr("(P[2][5]): expected a number"));
+  broken = j;
+  broken["N"] = 2.5;
+  EXPECT_THAT(error_of(broken.dump()), HasSubstr("(N)"));
+  broken = j;
+  broken["Ts"] = 0;
+  EXPECT_THAT(error_of(broken.dump()), HasSubstr("(Ts)"));
+  broken = j;
+  broken.erase("Gamma");
+  EXPECT_THAT(error_of(broken.dump()), HasSubstr("(Gamma): missing required field"));
+  broken = j;
+  broken["format"] = "servotwin.normal-equations/2";
+  EXPECT_THAT(error_of(broken.dump()), HasSubstr("unsupported version"));
+}
+
+TEST(RapidJson, ModelFileRoundTripsTheCoefficients) {
+  servotwin::vcnc::AxisIdentification r;
+  r.axis = "y";
+  r.ts = 0.001;
+  r.bounds = rapid::default_bounds(r.ts);
+  // Thesis Table 3.4, "Estimated" Y column.
+  r.solution.coefficients = {123.02, 40099.88, 146558.19, -0.08, 123.16, 40089.20, 478.0, -428.0};
+  r.solution.theta = rapid::theta_from_coefficients(r.solution.coefficients);
+  r.solution.method = rapid::Method::Exact;
+  r.fit = rapid::FitMetrics{1.0, 0.9, 0.1, 0.3, 0.1};
+  const nlohmann::json j = io::axis_model_to_json(r);
+  EXPECT_EQ(j["format"], "servotwin.axis-model/1");
+  for (const char* key : {"model", "search", "poles", "zeros", "bounds", "active_constraints", "objective", "fit", "solver"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["solver"]["method"], "exact");
+  EXPECT_TRUE(j["fit"].contains("rms"));
+  EXPECT_TRUE(j["fit"].contains("nrmse"));
+  const io::LoadedAxisModel back = io::parse_axis_model_json(j.dump(), "m.json");
+  EXPECT_EQ(back.axis, "y");
+  EXPECT_EQ(back.model.ts(), 0.001);
+  EXPECT_EQ(back.model.coefficients().a3, 146558.19);
+  EXPECT_EQ(back.model.coefficients().d1, -428.0);
+  EXPECT_EQ(back.method, "exact");
+}
+
+TEST(RapidJson, ModelFileErrors) {
+  const auto err = [](const std::string& text) {
+    try {
+      io::parse_axis_model_json(text, "m.json");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_THAT(err(R"({"format": "servotwin.axis-model/1", "axis": "x", "ts": 0.001, "model": {"a1": 1}})"),
+              HasSubstr("(model.a2): missing required field"));
+  EXPECT_THAT(err(R"({"format": "servotwin.machine/1"})"), HasSubstr("expected \"servotwin.axis-model/1\""));
+  EXPECT_THAT(err(R"({"format": "servotwin.axis-model/1", "axis": "x", "ts": -1,
+                     "model": {"a1": 1, "a2": 1, "a3": 1, "b0": 0, "b1": 0, "b2": 1, "d0": 0, "d1": 0}})"),
+              HasSubstr("(ts)"));
+}
+
+}  // namespace

@@ -1,0 +1,217 @@
+// Rapid identification end to end (thesis sections 3.4.1, 4.3.1 and 4.3.2): identify the
+// closed-loop axis model from a Table 3.2-style capture of each virtual machine preset and compare
+// it with the machine's true sampled loop (machine::discrete_tracking_tf, derived independently of
+// the identification) and with captures of other programs; then the same on the measured EMPS
+// axis. docs/rapid-identification-study.md reports these numbers (run test_validation to print them).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "servotwin/io/capture_csv.hpp"
+#include "validation_support.hpp"
+
+namespace servotwin::validation {
+namespace {
+
+/// Expected agreement per preset. PPI and PID meet the thesis's 10 % prediction target. The
+/// sliding-mode loop's tracking error (6.6 um RMS) is a discrete-time effect of its feed-forward
+/// that a continuous third-order model cannot follow: 17 % even on the ideal machine without
+/// friction or quantization. The ZPETC loop's tracking error (3.5 um RMS) is of the order of its
+/// 1.25 um encoder quantum (noise floor q / sqrt(12) = 0.36 um = 10 %); with an ideal encoder the
+/// prediction is within 10 % (ZpetcWithIdealEncoder below).
+struct Case {
+  const char* machine;
+  double frf_tolerance;         // largest relative tracking-FRF deviation, 0.5 to 30 Hz
+  double prediction_tolerance;  // RMS(predicted - actual tracking error) / RMS(actual)
+};
+
+struct Outcome {
+  vcnc::AxisIdentification identification;
+  double frf_error = 0.0;
+  double prediction_same_kind = 0.0;  // another Table 3.2 program (seed 11)
+  double prediction_high_set = 0.0;   // a Table 4.4 high-speed program
+};
+
+Outcome run_case(const machine::MachineConfig& machine, const vcnc::IdentificationSettings& settings) {
+  Outcome out;
+  out.identification = vcnc::identify_axis({thesis_capture(machine, 7)}, {}, "x", settings);
+  const int shift = out.identification.regressors.command_shift;
+  const rapid::AxisModel model(out.identification.solution.coefficients, machine.ts);
+  out.frf_error = tracking_frf_error(model, machine.axes.front(), machine.ts, shift, 0.5, 30.0);
+  out.prediction_same_kind = prediction_error_ratio(model, *thesis_capture(machine, 11).capture.find("x"), shift);
+  out.prediction_high_set =
+      prediction_error_ratio(model, *thesis_capture(machine, 5, motion::IdentificationSet::High).capture.find("x"), shift);
+  return out;
+}
+
+vcnc::IdentificationSettings searched_shift() {
+  vcnc::IdentificationSettings s;
+  s.shift_search = vcnc::ShiftSearch{};
+  return s;
+}
+
+/// The study's table: identified and true coefficients, poles, FRF at a few frequencies.
+void print(const machine::MachineConfig& m, const Outcome& o) {
+  const auto& s = o.identification.solution;
+  const auto& c = s.coefficients;
+  const auto truth = machine::equivalent_closed_loop(m.axes.front(), m.ts);
+  const auto& t = truth.coefficients;
+  const int shift = o.identification.regressors.command_shift;
+  std::printf("%s (%s, shift %d): wn %.2f Hz zeta %.3f p %.2f Hz, case %s\n", m.name.c_str(), rapid::method_name(s.method),
+              shift, s.wn / kTwoPi, s.zeta, s.p / kTwoPi, s.kkt_case.c_str());
+  std::printf("  identified a1 %.2f a2 %.2f a3 %.2f b0 %.3f b1 %.2f b2 %.2f d0 %.1f d1 %.1f\n", c.a1, c.a2, c.a3, c.b0,
+              c.b1, c.b2, c.d0, c.d1);
+  std::printf("  %s a1 %.2f a2 %.2f a3 %.2f b0 %.3f b1 %.2f b2 %.2f d0 %.1f d1 %.1f\n",
+              truth.exact ? "true      " : "equivalent", t.a1, t.a2, t.a3, t.b0, t.b1, t.b2, t.d0, t.d1);
+  const auto disc = machine::discrete_tracking_tf(m.axes.front(), m.ts);
+  const rapid::AxisModel model(c, m.ts);
+  for (double f : {1.0, 5.0, 10.0, 20.0, 30.0}) {
+    const auto g = shifted_tracking_response(model, kTwoPi * f, shift, m.ts);
+    const auto h = disc.frequency_response(kTwoPi * f);
+    std::printf("    %4.0f Hz: identified %.3f dB %.1f deg, true %.3f dB %.1f deg, rel err %.4f\n", f,
+                20 * std::log10(std::abs(g)), std::arg(g) * 180 / std::numbers::pi, 20 * std::log10(std::abs(h)),
+                std::arg(h) * 180 / std::numbers::pi, std::abs(g - h) / std::abs(h));
+  }
+  std::printf("  fit nrmse %.4f; FRF error 0.5-30 Hz %.4f; prediction error: other seed %.4f, high set %.4f\n",
+              o.identification.fit->nrmse, o.frf_error, o.prediction_same_kind, o.prediction_high_set);
+}
+
+class PresetIdentification : public ::testing::TestWithParam<Case> {};
+
+TEST_P(PresetIdentification, StableModelThatPredictsTrackingOfOtherPrograms) {
+  const Case c = GetParam();
+  const machine::MachineConfig machine = machine::preset(c.machine);
+  const Outcome o = run_case(machine, searched_shift());
+  print(machine, o);
+  const rapid::AxisModel model(o.identification.solution.coefficients, machine.ts);
+  EXPECT_TRUE(model.is_stable());
+  EXPECT_TRUE(o.identification.solution.feasible);
+  EXPECT_TRUE(o.identification.solution.certified);
+  EXPECT_LT(o.frf_error, c.frf_tolerance);
+  EXPECT_LT(o.prediction_same_kind, c.prediction_tolerance);
+  EXPECT_LT(o.prediction_high_set, c.prediction_tolerance);
+}
+
+TEST_P(PresetIdentification, SearchedShiftPredictsAtLeastAsWellAsTheControllersPreview) {
+  // The shift chosen by the fit on the identification data against the one the controller's
+  // structure suggests (1 for central-difference feed-forward, 2 for the ZPETC).
+  const machine::MachineConfig machine = machine::preset(GetParam().machine);
+  vcnc::IdentificationSettings preview;
+  preview.regressors.command_shift = machine::command_preview(machine.axes.front());
+  const Outcome fixed = run_case(machine, preview);
+  const Outcome searched = run_case(machine, searched_shift());
+  EXPECT_LE(searched.prediction_same_kind, fixed.prediction_same_kind * 1.001);
+  EXPECT_LE(searched.identification.fit->nrmse, fixed.identification.fit->nrmse);
+  ASSERT_EQ(searched.identification.shift_trials.size(), 7u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Presets, PresetIdentification,
+                         ::testing::Values(Case{"fadal-ppi", 0.08, 0.10}, Case{"fadal-pid", 0.03, 0.10},
+                                           Case{"fadal-smc", 0.05, 0.23}, Case{"ballscrew-zpetc", 0.01, 0.30}),
+                         [](const auto& param_info) {
+                           std::string n = param_info.param.machine;
+                           for (char& ch : n)
+                             if (ch == '-') ch = '_';
+                           return n;
+                         });
+
+TEST(PresetIdentification, ZpetcWithIdealEncoderPredictsWithinTenPercent) {
+  machine::MachineConfig machine = machine::preset("ballscrew-zpetc");
+  machine.axes.front().nonlinear.encoder_resolution = 0.0;
+  machine.axes.front().nonlinear.dac_bits = 0;
+  const Outcome o = run_case(machine, searched_shift());
+  print(machine, o);
+  EXPECT_LT(o.prediction_same_kind, 0.10);
+}
+
+TEST(PresetIdentification, GeneticAlgorithmIsNeverBetterThanExact) {
+  // The thesis's comparison (section 4.3): its GA came within 2-3 % of the optimum in minutes.
+  const machine::MachineConfig machine = machine::preset("fadal-pid");
+  vcnc::IdentificationSettings s;
+  s.regressors.command_shift = 0;
+  s.bounds.zeta_min = 0.6;  // make a bound active, so that the GA has to find the boundary optimum
+  const auto exact = vcnc::identify_axis({thesis_capture(machine, 7)}, {}, "x", s);
+  s.method = rapid::Method::Ga;
+  s.solve.ga.generations = 100;
+  const auto ga = vcnc::identify_axis({thesis_capture(machine, 7)}, {}, "x", s);
+  std::printf("fadal-pid, zeta >= 0.6: exact f = %.6g (%s, %.2f ms), ga f = %.6g (+%.3g %%, %.0f ms)\n",
+              exact.solution.objective, exact.solution.kkt_case.c_str(), exact.solution.time_ms, ga.solution.objective,
+              100.0 * (ga.solution.objective / exact.solution.objective - 1.0), ga.solution.time_ms);
+  EXPECT_EQ(exact.solution.kkt_case, "2: zeta = zeta_min");
+  EXPECT_GE(ga.solution.objective, exact.solution.lower_bound);
+  EXPECT_LE(ga.solution.objective, exact.solution.objective * 1.03);
+}
+
+// --- measured data: the EMPS ball-screw axis (data/emps/README.md) ---------------------------
+
+core::Capture read_emps(const char* file, double scale) {
+  io::CaptureReadOptions o;
+  o.map = {{"x_cmd", "qg"}, {"x_act", "qm"}};
+  o.scale = scale;
+  return io::read_capture_file(std::string(SERVOTWIN_REPO_DATA_DIR) + "/emps/" + file, o);
+}
+
+/// Samples [from, to) of a capture.
+vcnc::NamedCapture part(const core::Capture& c, std::size_t from, std::size_t to, const char* name) {
+  core::Capture out = c;
+  out.t0 = c.time(from);
+  for (auto& axis : out.axes) {
+    axis.cmd.assign(axis.cmd.begin() + static_cast<std::ptrdiff_t>(from), axis.cmd.begin() + static_cast<std::ptrdiff_t>(to));
+    axis.act.assign(axis.act.begin() + static_cast<std::ptrdiff_t>(from), axis.act.begin() + static_cast<std::ptrdiff_t>(to));
+    axis.u.clear();
+  }
+  return {name, out};
+}
+
+TEST(EmpsIdentification, BoundedModelIsStableAndPredictsOtherData) {
+  const core::Capture data = read_emps("DATA_EMPS.csv", 1000.0);
+  const std::size_t half = data.size() / 2;
+  const vcnc::NamedCapture first = part(data, 0, half, "EMPS first half");
+  const vcnc::NamedCapture second = part(data, half, data.size(), "EMPS second half");
+  const vcnc::NamedCapture pulses{"EMPS pulses", read_emps("DATA_EMPS_PULSES.csv", 1000.0)};
+
+  vcnc::IdentificationSettings ls;
+  ls.method = rapid::Method::Ls;
+  const auto unconstrained = vcnc::identify_axis({first}, {}, "x", ls);
+  vcnc::IdentificationSettings exact;
+  const auto bounded = vcnc::identify_axis({first}, {second}, "x", exact);
+  const auto bounded_pulses = vcnc::identify_axis({first}, {pulses}, "x", exact);
+  const auto& s = bounded.solution;
+  std::printf("EMPS ls: p %.4f Hz (feasible %d, stable %d)\n", unconstrained.solution.p / kTwoPi,
+              unconstrained.solution.feasible,
+              rapid::AxisModel(unconstrained.solution.coefficients, data.ts).is_stable());
+  std::printf("EMPS exact: wn %.3f Hz zeta %.4f p %.3f Hz, %s; fit %.4f, second half %.4f, pulses %.4f; %.2f ms\n",
+              s.wn / kTwoPi, s.zeta, s.p / kTwoPi, s.kkt_case.c_str(), bounded.fit->nrmse, bounded.validation->nrmse,
+              bounded_pulses.validation->nrmse, s.time_ms);
+  // Unconstrained least squares puts the slow real pole in the right half plane.
+  EXPECT_FALSE(unconstrained.solution.feasible);
+  EXPECT_FALSE(rapid::AxisModel(unconstrained.solution.coefficients, data.ts).is_stable());
+  // The bounded model is stable, holds p at its lower bound with a positive multiplier, and
+  // predicts the tracking error of data it has not seen.
+  EXPECT_TRUE(rapid::AxisModel(s.coefficients, data.ts).is_stable());
+  EXPECT_TRUE(s.certified);
+  ASSERT_EQ(s.active.size(), 1u);
+  EXPECT_EQ(s.active.front().name, "p_min");
+  EXPECT_GT(s.active.front().multiplier, 0.0);
+  EXPECT_LT(bounded.fit->nrmse, 0.05);
+  EXPECT_LT(bounded.validation->nrmse, 0.10);
+  EXPECT_LT(bounded_pulses.validation->nrmse, 0.25);
+}
+
+TEST(EmpsIdentification, SameModelInMetresAndMillimetres) {
+  const core::Capture mm = read_emps("DATA_EMPS.csv", 1000.0);
+  const core::Capture m = read_emps("DATA_EMPS.csv", 1.0);
+  const auto a = vcnc::identify_axis({{"mm", mm}}, {}, "x", {});
+  const auto b = vcnc::identify_axis({{"m", m}}, {}, "x", {});
+  EXPECT_EQ(a.solution.kkt_case, b.solution.kkt_case);
+  EXPECT_NEAR(a.solution.wn, b.solution.wn, 1e-8 * a.solution.wn);
+  EXPECT_NEAR(a.solution.zeta, b.solution.zeta, 1e-8);
+  EXPECT_NEAR(a.solution.p, b.solution.p, 1e-8 * a.solution.p);
+  // Friction is a force per mass (length / s^2): it scales with the unit; the rest does not.
+  EXPECT_NEAR(a.solution.coefficients.b2, b.solution.coefficients.b2, 1e-8 * std::abs(a.solution.coefficients.b2));
+  EXPECT_NEAR(a.solution.coefficients.d0, 1000.0 * b.solution.coefficients.d0, 1e-8 * std::abs(a.solution.coefficients.d0));
+  EXPECT_NEAR(a.fit->nrmse, b.fit->nrmse, 1e-8);
+}
+
+}  // namespace
+}  // namespace servotwin::validation
