@@ -5,6 +5,7 @@
 
 #include "command.hpp"
 #include "servotwin/core/error.hpp"
+#include "servotwin/motion/contour_programs.hpp"
 #include "servotwin/motion/gcode.hpp"
 #include "servotwin/motion/identification_program.hpp"
 #include "servotwin/motion/interpolation.hpp"
@@ -54,6 +55,29 @@ int run_identification(const IdentificationArgs& a, const GlobalOptions& global)
   out->commit();
   progress(global, "wrote {} ({} moves, +-{} mm, F{}, seed {})", a.output == "-" ? "program to stdout" : a.output,
            o.moves, o.range_mm, o.feed_mm_min, o.seed);
+  return kSuccess;
+}
+
+struct ContourArgs {
+  std::string shape = "circle";
+  motion::ContourProgramOptions options;
+  std::vector<double> center;
+  std::string output = "-";
+};
+
+int run_contour(const ContourArgs& a, const GlobalOptions& global) {
+  motion::ContourProgramOptions o = a.options;
+  if (!a.center.empty()) {
+    if (a.center.size() > motion::kAxisCount)
+      throw core::InputError({"", 0, 0, "--center"}, "give at most X Y Z, got " + std::to_string(a.center.size()) + " values");
+    for (std::size_t i = 0; i < a.center.size(); ++i) o.center[i] = a.center[i];
+  }
+  const motion::Program program = a.shape == "circle" ? motion::make_circle_program(o) : motion::make_diamond_program(o);
+  auto out = open_output(a.output, global);
+  out->stream() << motion::write_program(program);
+  out->commit();
+  progress(global, "wrote {} ({} of {} mm at F{})", a.output == "-" ? "program to stdout" : a.output, a.shape, o.size_mm,
+           o.feed_mm_min);
   return kSuccess;
 }
 
@@ -111,6 +135,7 @@ void register_gcode(CLI::App& app, Action& selected) {
   gcode->require_subcommand(1);
   set_examples(*gcode,
                "  servotwin gcode identification --axis X --seed 7 -o id.nc\n"
+               "  servotwin gcode contour --shape circle -o circle.nc\n"
                "  servotwin gcode check id.nc\n"
                "  servotwin gcode convert id.nc --to heidenhain -o id.h\n");
 
@@ -139,6 +164,24 @@ void register_gcode(CLI::App& app, Action& selected) {
                "  servotwin gcode identification --axis X --dialect heidenhain --speed low --seed 7 -o low.h\n"
                "  servotwin gcode identification --axis XY --speed high --dialect heidenhain -o high.h\n");
   gen->callback([id, &selected] { selected = [id](const GlobalOptions& g) { return run_identification(*id, g); }; });
+
+  auto contour = std::make_shared<ContourArgs>();
+  CLI::App* con = gcode->add_subcommand(
+      "contour", "Write a contouring test toolpath: the thesis's circle (40 mm diameter) or diamond, counter-clockwise in XY");
+  con->add_option("--shape", contour->shape, "circle or diamond")
+      ->check(CLI::IsMember({"circle", "diamond"}))
+      ->capture_default_str();
+  con->add_option("--size", contour->options.size_mm, "Circle diameter or diamond diagonal [mm]")->capture_default_str();
+  con->add_option("--feed", contour->options.feed_mm_min, "Programmed feed [mm/min] (F12000 = 200 mm/s)")
+      ->capture_default_str();
+  con->add_option("--center", contour->center, "Centre X Y [Z] [mm] (default: the origin)");
+  con->add_option("--dialect", contour->options.dialect, "Output dialect: iso or heidenhain")
+      ->transform(CLI::CheckedTransformer(kDialects, CLI::ignore_case))
+      ->capture_default_str();
+  con->add_option("-o,--output", contour->output, "Output file, - for standard output")->capture_default_str();
+  set_examples(*con, "  servotwin gcode contour --shape circle --size 40 --feed 12000 -o circle.nc\n"
+                     "  servotwin gcode contour --shape diamond -o diamond.nc\n");
+  con->callback([contour, &selected] { selected = [contour](const GlobalOptions& g) { return run_contour(*contour, g); }; });
 
   auto check = std::make_shared<ProgramArgs>();
   CLI::App* chk = gcode->add_subcommand("check", "Read a program and print a summary (errors: exit status 3)");

@@ -7,7 +7,9 @@
 #include "capture_input.hpp"
 #include "command.hpp"
 #include "model_summary.hpp"
+#include "report_output.hpp"
 #include "servotwin/io/rapid_json.hpp"
+#include "servotwin/report/identification_report.hpp"
 #include "solver_options.hpp"
 #include "servotwin/core/error.hpp"
 
@@ -24,7 +26,7 @@ struct IdentifyArgs {
   std::string shift = "auto";
   double trim_start_s = 0.0, trim_end_s = 0.0, deadband = 0.0;
   CLI::Option* deadband_opt = nullptr;
-  std::string output, stats_output;
+  std::string output, stats_output, report;
 };
 
 /// "model.json" for one axis; several axes need "{axis}" in the name.
@@ -101,8 +103,11 @@ int run(const IdentifyArgs& a, const GlobalOptions& global) {
   if (a.deadband_opt->count() > 0) settings.regressors.velocity_deadband = a.deadband;
 
   const std::vector<std::string> axes = axes_to_identify(a, captures, global);
+  const auto report_file = open_report(a.report, global);
+  std::vector<vcnc::AxisIdentification> records;
+  records.reserve(axes.size());
   for (const auto& axis : axes) {
-    vcnc::AxisIdentification record = vcnc::identify_axis(captures, validation, axis, settings);
+    vcnc::AxisIdentification& record = records.emplace_back(vcnc::identify_axis(captures, validation, axis, settings));
     record.length_unit = a.reading.scale == 1.0 ? "as in the file" : fmt::format("file unit x {}", a.reading.scale);
     print_model_summary(record);
     if (!a.stats_output.empty()) {
@@ -123,6 +128,7 @@ int run(const IdentifyArgs& a, const GlobalOptions& global) {
     }
   }
   progress(global, "identified {} axis(es) in {:.1f} ms", axes.size(), elapsed_ms(start));
+  if (report_file) write_report(report::identification_report(records, captures, validation), *report_file, global);
   return kSuccess;
 }
 
@@ -150,10 +156,12 @@ void register_identify(CLI::App& app, Action& selected) {
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", a->output, "Model file (servotwin.axis-model/1); {axis} in the name for several axes");
   cmd->add_option("--stats-out", a->stats_output, "Write the sufficient statistics (servotwin.normal-equations/1)");
+  add_report_option(*cmd, a->report);
   set_examples(*cmd,
                "  servotwin identify capture.csv --axis x --method exact -o model.json --stats-out stats.json\n"
                "  servotwin identify DATA_EMPS.csv --map x_cmd=qg --map x_act=qm --scale 1000 --validate other.csv -o model.json\n"
-               "  servotwin identify low.csv high.csv --method ga --seed 3 -o model_{axis}.json\n");
+               "  servotwin identify low.csv high.csv --method ga --seed 3 -o model_{axis}.json\n"
+               "  servotwin identify capture.csv --validate check.csv --report identification.html\n");
   cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });
 }
 

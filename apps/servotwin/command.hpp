@@ -38,6 +38,7 @@ void register_import(CLI::App& app, Action& selected);
 void register_identify(CLI::App& app, Action& selected);
 void register_solve(CLI::App& app, Action& selected);
 void register_model(CLI::App& app, Action& selected);
+void register_predict(CLI::App& app, Action& selected);
 
 /// Progress line on stderr (suppressed by --quiet).
 template <typename... Args>

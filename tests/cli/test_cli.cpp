@@ -23,7 +23,7 @@ TEST_F(Cli, HelpListsCommandsAndEveryCommandHasExamples) {
   const auto top = run("--help");
   EXPECT_EQ(top.status, 0);
   for (const char* c : {"gcode", "interpolate", "capture", "machine", "demo"}) EXPECT_THAT(top.out, HasSubstr(c));
-  for (const char* c : {"gcode", "gcode identification", "gcode check", "gcode convert", "interpolate", "capture", "import", "machine", "demo"}) {
+  for (const char* c : {"gcode", "gcode identification", "gcode contour", "gcode check", "gcode convert", "interpolate", "capture", "import", "identify", "solve", "model", "predict", "machine", "demo"}) {
     SCOPED_TRACE(c);
     const auto r = run(std::string(c) + " --help");
     EXPECT_EQ(r.status, 0);

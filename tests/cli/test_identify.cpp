@@ -188,3 +188,63 @@ TEST_F(Identify, FrictionWithoutReversalsIsReported) {
 }
 
 }  // namespace
+
+namespace {
+
+class Predict : public Identify {
+ protected:
+  /// model_<axis>.json for `axes` (e.g. "XY") identified from a PID-preset capture, and a contour toolpath.
+  void models_and_toolpath(const std::string& axes, const std::string& shape) const {
+    ASSERT_EQ(run("gcode identification --axis " + axes + " --seed 7 -o id.nc").status, 0);
+    ASSERT_EQ(run("capture --machine fadal-pid --program id.nc -o id.csv").status, 0);
+    ASSERT_EQ(run("identify id.csv -o model_{axis}.json").status, 0);
+    ASSERT_EQ(run("gcode contour --shape " + shape + " --size 40 --feed 12000 -o " + shape + ".nc").status, 0);
+  }
+};
+
+TEST_F(Predict, IssueCommandFormWithAndWithoutAMeasuredCapture) {
+  models_and_toolpath("XY", "circle");
+
+  auto r = run("predict --model model_x.json --model model_y.json --program circle.nc --machine fadal-pid -o prediction.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("contour error"));
+  const std::string csv = slurp(path("prediction.csv"));
+  EXPECT_THAT(csv, testing::StartsWith("t,x_cmd,x_pred,x_err,y_cmd,y_pred,y_err,contour_err,path\n"));
+  EXPECT_THAT(csv, HasSubstr(",arc\n"));
+
+  // The same program run on the virtual machine, scored against the prediction.
+  ASSERT_EQ(run("capture --machine fadal-pid --program circle.nc -o measured.csv").status, 0);
+  r = run("predict --model model_x.json --model model_y.json --program circle.nc --machine fadal-pid "
+          "--capture measured.csv -o compared.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("aligned at offset 0 samples"));
+  EXPECT_THAT(r.out, HasSubstr("contour"));
+  const std::string compared = slurp(path("compared.csv"));
+  EXPECT_THAT(compared, HasSubstr(",contour_err,path,x_meas,x_meas_err,y_meas,y_meas_err,contour_err_meas\n"));
+}
+
+TEST_F(Predict, BadInputIsReported) {
+  models_and_toolpath("X", "diamond");
+  // The diamond moves Y, which has no model.
+  auto r = run("predict --model model_x.json --program diamond.nc -o p.csv");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("moves axis Y but no model"));
+  // Models of different sample periods.
+  json other = read_json("model_x.json");
+  other["axis"] = "y";
+  other["ts"] = 0.002;
+  write("model_y.json", other.dump());
+  r = run("predict --model model_x.json --model model_y.json --program diamond.nc -o p.csv");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("model_y.json"));
+  EXPECT_THAT(r.err, HasSubstr("sample period"));
+  // A capture of another program.
+  other["ts"] = 0.001;
+  write("model_y.json", other.dump());
+  r = run("predict --model model_x.json --model model_y.json --program diamond.nc --capture id.csv -o p.csv");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("id.csv"));
+  EXPECT_FALSE(std::filesystem::exists(path("p.csv")));
+}
+
+}  // namespace

@@ -1,0 +1,57 @@
+#include "prediction_summary.hpp"
+
+#include <cmath>
+#include <fmt/core.h>
+
+namespace servotwin::cli {
+
+namespace {
+
+struct Extent {
+  double sum2 = 0.0, max = 0.0;
+  std::size_t n = 0;
+  void add(double v) {
+    sum2 += v * v;
+    max = std::max(max, std::abs(v));
+    ++n;
+  }
+  [[nodiscard]] double rms() const { return n == 0 ? 0.0 : std::sqrt(sum2 / static_cast<double>(n)); }
+};
+
+}  // namespace
+
+void print_prediction_summary(const vcnc::Prediction& p) {
+  fmt::print("prediction: {} samples ({:.3f} s at ts = {} s)\n", p.size(),
+             static_cast<double>(p.size() > 0 ? p.size() - 1 : 0) * p.ts, p.ts);
+  for (std::size_t i = 0; i < p.axes.size(); ++i) {
+    Extent e;
+    for (std::size_t k = 0; k < p.size(); ++k) e.add(p.tracking_error(i, k));
+    fmt::print("  axis {} tracking error: rms {:.4g}, max {:.4g}\n", motion::axis_name(p.axes[i]), e.rms(), e.max);
+  }
+  Extent all;
+  std::array<Extent, 4> by_kind{};
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    all.add(p.contour_error[k]);
+    by_kind[static_cast<std::size_t>(p.kind[k])].add(p.contour_error[k]);
+  }
+  fmt::print("  contour error: rms {:.4g}, max {:.4g}", all.rms(), all.max);
+  for (std::size_t k = 0; k < by_kind.size(); ++k) {
+    if (by_kind[k].n == 0) continue;
+    fmt::print("; {} rms {:.4g} max {:.4g}", motion::path_kind_name(static_cast<motion::PathKind>(k)), by_kind[k].rms(),
+               by_kind[k].max);
+  }
+  fmt::print("\n");
+}
+
+void print_comparison(const vcnc::MeasuredComparison& m, double ts) {
+  fmt::print("measured capture aligned at offset {} samples ({:+.3f} s); {} samples compared; command mismatch rms {:.3g}\n",
+             m.offset, static_cast<double>(m.offset) * ts, m.count, m.command_mismatch_rms);
+  fmt::print("  {:<12} {:<6} {:>12} {:>12} {:>12} {:>8}\n", "quantity", "path", "measured rms", "predicted rms",
+             "max |diff|", "nrmse");
+  for (const auto& s : m.scores) {
+    fmt::print("  {:<12} {:<6} {:>12.4g} {:>12.4g} {:>12.4g} {:>8.4f}\n", s.quantity, s.kind, s.metrics.rms_measured,
+               s.metrics.rms_predicted, s.metrics.max_difference, s.metrics.nrmse);
+  }
+}
+
+}  // namespace servotwin::cli

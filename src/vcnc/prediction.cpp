@@ -1,0 +1,232 @@
+#include "servotwin/vcnc/prediction.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "servotwin/core/error.hpp"
+
+namespace servotwin::vcnc {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+core::InputError error_at(const std::string& source, const std::string& field, const std::string& message) {
+  return core::InputError({source, 0, 0, field}, message);
+}
+
+std::optional<motion::Axis> axis_of(const std::string& name) {
+  if (name == "x" || name == "X") return motion::Axis::X;
+  if (name == "y" || name == "Y") return motion::Axis::Y;
+  if (name == "z" || name == "Z") return motion::Axis::Z;
+  return std::nullopt;
+}
+
+/// Models by program axis (index X, Y, Z), checked: known names, no repeats, one sample period.
+std::array<const AxisModelSpec*, motion::kAxisCount> models_by_axis(const std::vector<AxisModelSpec>& models) {
+  if (models.empty()) throw core::InputError("no axis model given: prediction needs one model per moving axis");
+  std::array<const AxisModelSpec*, motion::kAxisCount> by_axis{};
+  for (const auto& m : models) {
+    const auto axis = axis_of(m.axis);
+    if (!axis) throw error_at(m.source, "axis", "model axis '" + m.axis + "' is not x, y or z");
+    const auto i = static_cast<std::size_t>(*axis);
+    if (by_axis[i] != nullptr)
+      throw error_at(m.source, "axis", "a second model for axis " + m.axis + " (the first is " + by_axis[i]->source + ")");
+    const double ts = models.front().model.ts();
+    if (std::abs(m.model.ts() - ts) > 1e-9 * ts)
+      throw error_at(m.source, "ts",
+                     "sample period " + std::to_string(m.model.ts()) + " s differs from " + models.front().source + "'s " +
+                         std::to_string(ts) + " s: the models of one machine share the sample period");
+    by_axis[i] = &m;
+  }
+  return by_axis;
+}
+
+std::vector<motion::PathKind> kinds_of(const motion::ContourPath& path, std::size_t n, double ts) {
+  std::vector<motion::PathKind> kind(n);
+  for (std::size_t k = 0; k < n; ++k) kind[k] = path.kind_at(static_cast<double>(k) * ts);
+  return kind;
+}
+
+}  // namespace
+
+Prediction predict(const motion::Program& program, const std::string& program_name, motion::InterpolationLimits limits,
+                   const std::vector<AxisModelSpec>& models, const PredictionOptions& options) {
+  const auto by_axis = models_by_axis(models);
+  std::vector<motion::Axis> axes;
+  const std::uint8_t used = program.used_axes();
+  for (std::size_t i = 0; i < motion::kAxisCount; ++i) {
+    const auto axis = static_cast<motion::Axis>(i);
+    const bool moves = (used & motion::axis_bit(axis)) != 0;
+    if (moves && by_axis[i] == nullptr) {
+      throw error_at(program_name, "", std::string("the program moves axis ") + motion::axis_letter(axis) +
+                                           " but no model is given for it (add --model with axis " +
+                                           motion::axis_name(axis) + ")");
+    }
+    if (moves) axes.push_back(axis);
+  }
+  if (axes.empty()) throw error_at(program_name, "", "the program moves no axis: nothing to predict");
+
+  Prediction out;
+  out.ts = models.front().model.ts();
+  out.contour_window_s = options.contour_window_s;
+  limits.ts = out.ts;
+  const motion::MotionPlan plan = motion::plan_motion(program, limits);
+  const motion::Trajectory trajectory = motion::sample(plan, axes);
+  out.axes = trajectory.axes;
+  out.command = trajectory.positions;
+  out.predicted.resize(out.axes.size());
+  for (std::size_t i = 0; i < out.axes.size(); ++i) {
+    const AxisModelSpec& spec = *by_axis[static_cast<std::size_t>(out.axes[i])];
+    rapid::ModelSimulationOptions sim;
+    sim.command_shift = spec.command_shift;
+    sim.initial_position = out.command[i].front();
+    out.predicted[i] = spec.model.simulate(out.command[i], sim).position;
+  }
+  auto path = std::make_shared<motion::ContourPath>(program, plan);
+  out.contour_error = motion::contour_errors(*path, out.axes, out.predicted, out.ts, options.contour_window_s);
+  out.kind = kinds_of(*path, trajectory.size(), out.ts);
+  out.path = std::move(path);
+  return out;
+}
+
+namespace {
+
+/// First sample at which any column leaves its first value by more than `tolerance`.
+std::size_t motion_start(const std::vector<const std::vector<double>*>& columns, double tolerance) {
+  const std::size_t n = columns.front()->size();
+  for (std::size_t k = 0; k < n; ++k) {
+    for (const auto* c : columns)
+      if (std::abs((*c)[k] - c->front()) > tolerance) return k;
+  }
+  return n;
+}
+
+struct Alignment {
+  std::ptrdiff_t offset = 0;
+  std::size_t first = 0, count = 0;
+  double rms = std::numeric_limits<double>::infinity();
+};
+
+/// Overlap of prediction samples [0, n) with capture samples [0, m) under `offset`, and the RMS
+/// command difference over it.
+Alignment score_offset(const std::vector<const std::vector<double>*>& predicted_cmd,
+                       const std::vector<const std::vector<double>*>& captured_cmd, std::ptrdiff_t offset) {
+  const auto n = static_cast<std::ptrdiff_t>(predicted_cmd.front()->size());
+  const auto m = static_cast<std::ptrdiff_t>(captured_cmd.front()->size());
+  Alignment a;
+  a.offset = offset;
+  const std::ptrdiff_t first = std::max<std::ptrdiff_t>(0, -offset);
+  const std::ptrdiff_t last = std::min(n, m - offset);
+  if (last <= first) return a;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < predicted_cmd.size(); ++i) {
+    for (std::ptrdiff_t k = first; k < last; ++k) {
+      const double d = (*captured_cmd[i])[static_cast<std::size_t>(k + offset)] - (*predicted_cmd[i])[static_cast<std::size_t>(k)];
+      sum += d * d;
+    }
+  }
+  a.first = static_cast<std::size_t>(first);
+  a.count = static_cast<std::size_t>(last - first);
+  a.rms = std::sqrt(sum / static_cast<double>(a.count * predicted_cmd.size()));
+  return a;
+}
+
+void add_scores(MeasuredComparison& out, const std::string& quantity, const std::vector<double>& measured,
+                const std::vector<double>& predicted, const std::vector<motion::PathKind>& kind) {
+  const std::size_t begin = out.first, end = out.first + out.count;
+  out.scores.push_back({quantity, "all",
+                        rapid::compare_tracking(std::span(measured).subspan(begin, out.count),
+                                                std::span(predicted).subspan(begin, out.count))});
+  for (const auto k : {motion::PathKind::Line, motion::PathKind::Arc, motion::PathKind::Rapid, motion::PathKind::Stop}) {
+    std::vector<double> m, p;
+    for (std::size_t s = begin; s < end; ++s) {
+      if (kind[s] != k) continue;
+      m.push_back(measured[s]);
+      p.push_back(predicted[s]);
+    }
+    if (m.size() >= 10) out.scores.push_back({quantity, motion::path_kind_name(k), rapid::compare_tracking(m, p)});
+  }
+}
+
+}  // namespace
+
+MeasuredComparison compare_with_capture(const Prediction& prediction, const core::Capture& capture,
+                                        const std::string& source) {
+  if (prediction.size() == 0) throw core::InputError("empty prediction");
+  if (std::abs(capture.ts - prediction.ts) > 1e-6 * prediction.ts) {
+    throw error_at(source, "t", "sample period " + std::to_string(capture.ts) + " s differs from the models' " +
+                                    std::to_string(prediction.ts) + " s");
+  }
+  std::vector<const std::vector<double>*> predicted_cmd, captured_cmd, captured_act;
+  double range = 0.0;
+  for (std::size_t i = 0; i < prediction.axes.size(); ++i) {
+    const std::string name = motion::axis_name(prediction.axes[i]);
+    const core::AxisTrace* trace = capture.find(name);
+    if (trace == nullptr) throw error_at(source, name + "_cmd", "the capture has no axis " + name + ", which the program moves");
+    predicted_cmd.push_back(&prediction.command[i]);
+    captured_cmd.push_back(&trace->cmd);
+    captured_act.push_back(&trace->act);
+    const auto [lo, hi] = std::minmax_element(prediction.command[i].begin(), prediction.command[i].end());
+    range = std::max(range, *hi - *lo);
+  }
+  if (capture.size() == 0) throw error_at(source, "", "the capture has no samples");
+
+  // Coarse: the starts of motion; fine: least squares over +-50 samples around it.
+  const double tolerance = 1e-6 * range + 1e-12;
+  const auto start_p = static_cast<std::ptrdiff_t>(motion_start(predicted_cmd, tolerance));
+  const auto start_c = static_cast<std::ptrdiff_t>(motion_start(captured_cmd, tolerance));
+  Alignment best;
+  for (std::ptrdiff_t d = -50; d <= 50; ++d) {
+    const Alignment a = score_offset(predicted_cmd, captured_cmd, start_c - start_p + d);
+    if (a.count * 2 >= prediction.size() && a.rms < best.rms) best = a;
+  }
+  if (!std::isfinite(best.rms)) {
+    throw error_at(source, "", "the capture covers less than half of the program's " + std::to_string(prediction.size()) +
+                                   " samples: is it a capture of this program?");
+  }
+  if (best.rms > 1e-3 * range + 1e-9) {
+    throw error_at(source, "", "the capture's commanded positions differ from the program's by " + std::to_string(best.rms) +
+                                   " RMS after the best time alignment (motion range " + std::to_string(range) +
+                                   "): is it a capture of this program, with the same feed and acceleration?");
+  }
+
+  MeasuredComparison out;
+  out.offset = best.offset;
+  out.first = best.first;
+  out.count = best.count;
+  out.command_mismatch_rms = best.rms;
+  const std::size_t n = prediction.size();
+  out.actual.assign(prediction.axes.size(), std::vector<double>(n, kNaN));
+  for (std::size_t i = 0; i < prediction.axes.size(); ++i) {
+    for (std::size_t k = out.first; k < out.first + out.count; ++k)
+      out.actual[i][k] = (*captured_act[i])[static_cast<std::size_t>(static_cast<std::ptrdiff_t>(k) + out.offset)];
+  }
+  out.contour_error.assign(n, kNaN);
+  motion::Point p = prediction.path->start_point();
+  for (std::size_t k = out.first; k < out.first + out.count; ++k) {
+    for (std::size_t i = 0; i < prediction.axes.size(); ++i) p[static_cast<std::size_t>(prediction.axes[i])] = out.actual[i][k];
+    out.contour_error[k] =
+        prediction.path->nearest(p, static_cast<double>(k) * prediction.ts, prediction.contour_window_s).signed_distance;
+  }
+
+  out.tracking_error.assign(prediction.axes.size(), std::vector<double>(n, kNaN));
+  for (std::size_t i = 0; i < prediction.axes.size(); ++i) {
+    std::vector<double> predicted(n, 0.0);
+    for (std::size_t k = out.first; k < out.first + out.count; ++k) {
+      // The measured tracking error is the capture's own: its command minus its position.
+      out.tracking_error[i][k] =
+          (*captured_cmd[i])[static_cast<std::size_t>(static_cast<std::ptrdiff_t>(k) + out.offset)] - out.actual[i][k];
+      predicted[k] = prediction.tracking_error(i, k);
+    }
+    add_scores(out, std::string(motion::axis_name(prediction.axes[i])) + " tracking", out.tracking_error[i], predicted,
+               prediction.kind);
+  }
+  add_scores(out, "contour", out.contour_error, prediction.contour_error, prediction.kind);
+  return out;
+}
+
+}  // namespace servotwin::vcnc
