@@ -1,6 +1,14 @@
 #include "servotwin/core/error.hpp"
 
+#include <utility>
+
 namespace servotwin::core {
+
+SourceLocation at_field(std::string field) {
+  SourceLocation where;
+  where.field = std::move(field);
+  return where;
+}
 
 // Built with append() rather than operator+ chains: GCC 12 reports a false -Wrestrict on the
 // latter (GCC bug 105329).

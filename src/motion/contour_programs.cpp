@@ -11,9 +11,7 @@ namespace {
 
 void validate(const ContourProgramOptions& o) {
   const auto fail = [](const char* field, const std::string& message) {
-    core::SourceLocation where;
-    where.field = field;
-    throw core::InputError(where, message);
+    throw core::InputError(core::at_field(field), message);
   };
   if (!std::isfinite(o.size_mm) || o.size_mm <= 0.0) fail("size_mm", "must be a finite length > 0 mm");
   if (!std::isfinite(o.feed_mm_min) || o.feed_mm_min <= 0.0 || o.feed_mm_min > 1e9)

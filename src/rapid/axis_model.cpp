@@ -16,16 +16,10 @@ namespace servotwin::rapid {
 
 namespace {
 
-core::SourceLocation field(std::string name) {
-  core::SourceLocation where;
-  where.field = std::move(name);
-  return where;
-}
-
 void require_finite(const Vector8& theta, const std::string& what) {
   for (int k = 0; k < kParameterCount; ++k) {
     if (!std::isfinite(theta(k))) {
-      throw core::InputError(field(what), "parameter " + std::to_string(k) + " (" +
+      throw core::InputError(core::at_field(what), "parameter " + std::to_string(k) + " (" +
                                               std::string(kRegressorNames[static_cast<std::size_t>(k)]) +
                                               ") is not finite");
     }
@@ -36,7 +30,7 @@ void require_finite_coefficients(const ModelCoefficients& c) {
   const std::pair<const char*, double> values[] = {{"a1", c.a1}, {"a2", c.a2}, {"a3", c.a3}, {"b0", c.b0},
                                                    {"b1", c.b1}, {"b2", c.b2}, {"d0", c.d0}, {"d1", c.d1}};
   for (const auto& [name, value] : values) {
-    if (!std::isfinite(value)) throw core::InputError(field(name), "model coefficient must be finite");
+    if (!std::isfinite(value)) throw core::InputError(core::at_field(name), "model coefficient must be finite");
   }
 }
 
@@ -72,7 +66,7 @@ AxisModel::Kernel make_kernel(const ModelCoefficients& c, double ts) {
 ModelCoefficients coefficients_from_theta(const Vector8& theta) {
   require_finite(theta, "theta");
   const double alpha2 = theta(2);
-  if (alpha2 == 0.0) throw core::InputError(field("theta[2] (alpha_2)"), "alpha_2 = 1/a2 must be nonzero");
+  if (alpha2 == 0.0) throw core::InputError(core::at_field("theta[2] (alpha_2)"), "alpha_2 = 1/a2 must be nonzero");
   const double a2 = 1.0 / alpha2;
   ModelCoefficients c;
   c.a2 = a2;
@@ -88,7 +82,7 @@ ModelCoefficients coefficients_from_theta(const Vector8& theta) {
 
 Vector8 theta_from_coefficients(const ModelCoefficients& c) {
   if (!std::isfinite(c.a2) || c.a2 == 0.0) {
-    throw core::InputError(field("a2"), "a2 must be finite and nonzero to normalise the model (Eq. 3.10)");
+    throw core::InputError(core::at_field("a2"), "a2 must be finite and nonzero to normalise the model (Eq. 3.10)");
   }
   const double inv = 1.0 / c.a2;
   Vector8 theta;
@@ -99,7 +93,7 @@ Vector8 theta_from_coefficients(const ModelCoefficients& c) {
 
 AxisModel::AxisModel(const ModelCoefficients& coefficients, double ts) : c_(coefficients), ts_(ts) {
   require_finite_coefficients(c_);
-  if (!std::isfinite(ts) || ts <= 0.0) throw core::InputError(field("ts"), "sample period must be finite and > 0");
+  if (!std::isfinite(ts) || ts <= 0.0) throw core::InputError(core::at_field("ts"), "sample period must be finite and > 0");
   kernel_ = make_kernel(c_, ts_);
 }
 

@@ -12,16 +12,10 @@ namespace servotwin::rapid {
 
 namespace {
 
-core::SourceLocation field(std::string name) {
-  core::SourceLocation where;
-  where.field = std::move(name);
-  return where;
-}
-
 void require_finite(std::span<const double> values, const char* name) {
   for (std::size_t k = 0; k < values.size(); ++k) {
     if (!std::isfinite(values[k])) {
-      throw core::InputError(field(std::string(name) + "[" + std::to_string(k) + "]"),
+      throw core::InputError(core::at_field(std::string(name) + "[" + std::to_string(k) + "]"),
                              "tracking error sample must be finite (an unstable model's prediction diverges)");
     }
   }
@@ -50,11 +44,11 @@ class Norm {
 
 FitMetrics compare_tracking(std::span<const double> measured_error, std::span<const double> predicted_error) {
   if (measured_error.size() != predicted_error.size()) {
-    throw core::InputError(field("predicted_error"), "length " + std::to_string(predicted_error.size()) +
+    throw core::InputError(core::at_field("predicted_error"), "length " + std::to_string(predicted_error.size()) +
                                                          " differs from the measured error's " +
                                                          std::to_string(measured_error.size()));
   }
-  if (measured_error.empty()) throw core::InputError(field("measured_error"), "at least one sample is required");
+  if (measured_error.empty()) throw core::InputError(core::at_field("measured_error"), "at least one sample is required");
   require_finite(measured_error, "measured_error");
   require_finite(predicted_error, "predicted_error");
 
@@ -93,13 +87,13 @@ FitMetrics compare_tracking(std::span<const double> measured_error, std::span<co
 FitMetrics simulation_fit(const AxisModel& model, std::span<const double> command, std::span<const double> actual,
                           const ModelSimulationOptions& options) {
   if (command.size() != actual.size()) {
-    throw core::InputError(field("actual"), "length " + std::to_string(actual.size()) + " differs from the command's " +
+    throw core::InputError(core::at_field("actual"), "length " + std::to_string(actual.size()) + " differs from the command's " +
                                                 std::to_string(command.size()));
   }
-  if (command.empty()) throw core::InputError(field("command"), "at least one sample is required");
+  if (command.empty()) throw core::InputError(core::at_field("command"), "at least one sample is required");
   for (std::size_t k = 0; k < actual.size(); ++k) {
     if (!std::isfinite(actual[k]))
-      throw core::InputError(field("actual[" + std::to_string(k) + "]"), "actual position sample must be finite");
+      throw core::InputError(core::at_field("actual[" + std::to_string(k) + "]"), "actual position sample must be finite");
   }
   ModelSimulationOptions opts = options;
   if (!opts.initial_position) opts.initial_position = actual.front();

@@ -313,12 +313,6 @@ class Integrator {
   double friction_max_ = 0.0;
 };
 
-core::SourceLocation field(std::string name) {
-  core::SourceLocation where;
-  where.field = std::move(name);
-  return where;
-}
-
 }  // namespace
 
 ModelResponse AxisModel::simulate(std::span<const double> command, const ModelSimulationOptions& options) const {
@@ -332,14 +326,14 @@ void AxisModel::simulate_into(std::span<const double> command, ModelResponse& ou
   const std::size_t n = command.size();
   for (std::size_t k = 0; k < n; ++k) {
     if (!std::isfinite(command[k]))
-      throw core::InputError(field("command[" + std::to_string(k) + "]"), "command sample must be finite");
+      throw core::InputError(core::at_field("command[" + std::to_string(k) + "]"), "command sample must be finite");
   }
   if (options.initial_position && !std::isfinite(*options.initial_position))
-    throw core::InputError(field("initial_position"), "must be finite");
+    throw core::InputError(core::at_field("initial_position"), "must be finite");
   if (options.initial_integrator && !std::isfinite(*options.initial_integrator))
-    throw core::InputError(field("initial_integrator"), "must be finite");
+    throw core::InputError(core::at_field("initial_integrator"), "must be finite");
   if (!kernel_.valid) {
-    throw core::InputError(field("ts"), "the model grows by more than exp(700) within one sample period; "
+    throw core::InputError(core::at_field("ts"), "the model grows by more than exp(700) within one sample period; "
                                         "its zero-order-hold matrices overflow");
   }
   out.position.resize(n);

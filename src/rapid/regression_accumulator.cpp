@@ -40,9 +40,7 @@ constexpr double kDeadbandTieMargin = 1e-9;
 constexpr double kNoiseDeadbandFactor = 4.0;
 
 core::InputError field_error(const std::string& field, const std::string& message) {
-  core::SourceLocation where;
-  where.field = field;
-  return core::InputError(where, message);
+  return core::InputError(core::at_field(field), message);
 }
 
 /// A span as an Eigen vector, for Eigen's vectorized reductions (scalar min/max chains are

@@ -19,9 +19,7 @@ using detail::kAugmentedColumns;
 using Vector9 = Eigen::Matrix<double, kAugmentedColumns, 1>;
 
 core::InputError field_error(const char* field, const std::string& message) {
-  core::SourceLocation where;
-  where.field = field;
-  return core::InputError(where, message);
+  return core::InputError(core::at_field(field), message);
 }
 
 bool all_finite(const Matrix9& m) noexcept { return m.allFinite(); }

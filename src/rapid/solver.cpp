@@ -18,9 +18,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 core::InputError field_error(const std::string& field, const std::string& message) {
-  core::SourceLocation where;
-  where.field = field;
-  return core::InputError(where, message);
+  return core::InputError(core::at_field(field), message);
 }
 
 std::string format_number(double v) {

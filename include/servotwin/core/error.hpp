@@ -18,6 +18,10 @@ struct SourceLocation {
   std::string field;       ///< JSON field, CSV column or option name, empty = none
 };
 
+/// A location that is a field alone (a parameter, option or JSON member), for errors in values
+/// given through the API rather than read from a file.
+SourceLocation at_field(std::string field);
+
 /// Formats a location as `file:line:column` followed by ` (field)` when a field is set.
 std::string to_string(const SourceLocation& where);
 
