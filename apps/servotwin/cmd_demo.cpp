@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "command.hpp"
+#include "model_summary.hpp"
 #include "report_output.hpp"
 #include "servotwin/report/identification_report.hpp"
 #include "servotwin/report/prediction_report.hpp"
@@ -31,15 +32,6 @@ struct DemoArgs {
   std::size_t ga_generations = 500;
   std::string out_dir, report;
 };
-
-std::string pole_summary(const std::vector<core::ModalInfo>& roots) {
-  std::string out;
-  for (const auto& r : roots) {
-    if (r.root.imag() < 0.0) continue;
-    out += fmt::format("{}{:.2f} Hz/{:.2f}", out.empty() ? "" : ", ", r.freq_hz, r.zeta);
-  }
-  return out.empty() ? "none" : out;
-}
 
 void write_file(const std::filesystem::path& path, const GlobalOptions& global, const auto& writer) {
   auto out = open_output(path.string(), global);
@@ -74,9 +66,9 @@ void print_identification(const machine::MachineConfig& machine, const std::vect
     const auto axis = std::find_if(machine.axes.begin(), machine.axes.end(), [&](const auto& c) { return c.name == m.axis; });
     if (axis == machine.axes.end()) continue;
     const auto truth = machine::equivalent_closed_loop(*axis, machine.ts);
-    fmt::print("   axis {}: true poles       {}{}\n", m.axis, pole_summary(truth.poles), truth.exact ? "" : " (equivalent)");
+    fmt::print("   axis {}: true poles       {}{}\n", m.axis, roots_text(truth.poles), truth.exact ? "" : " (equivalent)");
     fmt::print("           identified poles {}; {}; command shift {}; fit nrmse {:.4f}\n",
-               pole_summary(rapid::AxisModel(s.coefficients, m.ts).poles()),
+               roots_text(rapid::AxisModel(s.coefficients, m.ts).poles()),
                rapid::AxisModel(s.coefficients, m.ts).is_stable() ? "stable" : "UNSTABLE", m.regressors.command_shift,
                m.fit->nrmse);
     fmt::print("           solver: case {}, objective {:.6g}, certified gap {:.2g}, {:.2f} ms\n", s.kkt_case,
@@ -122,8 +114,8 @@ report::Document demo_report(const machine::MachineConfig& machine, const std::v
   for (const auto& m : models) {
     const auto axis = std::find_if(machine.axes.begin(), machine.axes.end(), [&](const auto& c) { return c.name == m.axis; });
     if (axis == machine.axes.end()) continue;
-    poles.rows.push_back({m.axis, pole_summary(machine::equivalent_closed_loop(*axis, machine.ts).poles),
-                          pole_summary(rapid::AxisModel(m.solution.coefficients, m.ts).poles())});
+    poles.rows.push_back({m.axis, roots_text(machine::equivalent_closed_loop(*axis, machine.ts).poles),
+                          roots_text(rapid::AxisModel(m.solution.coefficients, m.ts).poles())});
   }
   overview.tables.push_back(std::move(poles));
   report::Table contour;

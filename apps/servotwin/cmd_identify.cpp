@@ -41,24 +41,15 @@ std::string output_for(const std::string& pattern, const std::string& axis, std:
   return pattern.substr(0, at) + axis + pattern.substr(at + 6);
 }
 
-bool command_moves(const core::AxisTrace& trace) {
-  const auto [lo, hi] = std::minmax_element(trace.cmd.begin(), trace.cmd.end());
-  return lo != trace.cmd.end() && *lo != *hi;
-}
-
 /// --axis as given, else every axis whose command moves in some capture (a 3-axis capture of a
 /// one-axis program holds two axes at rest, which are skipped with a note).
 std::vector<std::string> axes_to_identify(const IdentifyArgs& a, const std::vector<vcnc::NamedCapture>& captures,
                                           const GlobalOptions& global) {
   if (!a.axes.empty()) return a.axes;
-  std::vector<std::string> names;
+  std::vector<std::string> names = vcnc::moving_axes(captures);
   for (const auto& axis : captures.front().capture.axes) {
-    const bool moves = std::any_of(captures.begin(), captures.end(), [&](const vcnc::NamedCapture& c) {
-      const core::AxisTrace* t = c.capture.find(axis.name);
-      return t != nullptr && command_moves(*t);
-    });
-    if (moves) names.push_back(axis.name);
-    else progress(global, "axis {}: the command never moves, skipped", axis.name);
+    if (std::find(names.begin(), names.end(), axis.name) == names.end())
+      progress(global, "axis {}: the command never moves, skipped", axis.name);
   }
   if (names.empty()) {
     throw core::InputError({captures.front().source, 0, 0, "x_cmd"},

@@ -16,12 +16,15 @@ std::string root_text(const core::ModalInfo& m) {
 }
 }  // namespace
 
-void print_roots(const char* label, const std::vector<core::ModalInfo>& roots) {
-  fmt::print("  {}:", label);
-  if (roots.empty()) fmt::print(" none");
+std::string roots_text(const std::vector<core::ModalInfo>& roots) {
+  std::string out;
   for (const auto& m : roots)
-    if (m.root.imag() >= 0.0) fmt::print(" [{}]", root_text(m));
-  fmt::print("\n");
+    if (m.root.imag() >= 0.0) out += fmt::format("{}[{}]", out.empty() ? "" : " ", root_text(m));
+  return out.empty() ? "none" : out;
+}
+
+void print_roots(const char* label, const std::vector<core::ModalInfo>& roots) {
+  fmt::print("  {}: {}\n", label, roots_text(roots));
 }
 
 void print_model_summary(const vcnc::AxisIdentification& r) {

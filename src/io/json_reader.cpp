@@ -26,6 +26,12 @@ nlohmann::json parse_json_text(std::string_view text, std::string_view source_na
     std::string what = e.what();
     if (const auto pos = what.find("syntax error"); pos != std::string::npos) what = what.substr(pos);
     throw core::InputError({std::string(source_name), line, column, ""}, "invalid JSON: " + what);
+  } catch (const nlohmann::json::out_of_range& e) {
+    // A number such as 1e999 overflows a double while parsing; the parser does not say where.
+    std::string what = e.what();
+    if (const auto pos = what.find("number overflow"); pos != std::string::npos) what = what.substr(pos);
+    throw core::InputError({std::string(source_name), 0, 0, ""},
+                           "invalid JSON: " + what + " (a number does not fit a double)");
   }
 }
 

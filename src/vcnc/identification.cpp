@@ -140,6 +140,23 @@ std::size_t choose_shift(const std::vector<ShiftTrial>& trials) {
 
 }  // namespace
 
+std::vector<std::string> moving_axes(const std::vector<NamedCapture>& captures) {
+  std::vector<std::string> names;
+  if (captures.empty()) return names;
+  const auto command_moves = [](const core::AxisTrace& trace) {
+    const auto [lo, hi] = std::minmax_element(trace.cmd.begin(), trace.cmd.end());
+    return lo != trace.cmd.end() && *lo != *hi;
+  };
+  for (const auto& axis : captures.front().capture.axes) {
+    const bool moves = std::any_of(captures.begin(), captures.end(), [&](const NamedCapture& c) {
+      const core::AxisTrace* t = c.capture.find(axis.name);
+      return t != nullptr && command_moves(*t);
+    });
+    if (moves) names.push_back(axis.name);
+  }
+  return names;
+}
+
 AxisIdentification identify_axis(const std::vector<NamedCapture>& captures, const std::vector<NamedCapture>& validation,
                                  const std::string& axis, const IdentificationSettings& settings) {
   if (captures.empty()) throw core::InputError("no captures to identify from");

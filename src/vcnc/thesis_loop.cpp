@@ -22,12 +22,7 @@ IdentificationExperiment run_identification_experiment(const machine::MachineCon
 std::vector<AxisIdentification> identify_axes(const std::vector<NamedCapture>& captures,
                                               const IdentificationSettings& settings) {
   std::vector<AxisIdentification> out;
-  if (captures.empty()) return out;
-  for (const auto& axis : captures.front().capture.axes) {
-    const auto [lo, hi] = std::minmax_element(axis.cmd.begin(), axis.cmd.end());
-    if (lo == axis.cmd.end() || *lo == *hi) continue;
-    out.push_back(identify_axis(captures, {}, axis.name, settings));
-  }
+  for (const auto& axis : moving_axes(captures)) out.push_back(identify_axis(captures, {}, axis, settings));
   return out;
 }
 

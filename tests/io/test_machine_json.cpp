@@ -86,6 +86,14 @@ TEST(MachineJson, SyntaxErrorsHaveLineAndColumn) {
   EXPECT_THAT(e, HasSubstr("invalid JSON"));
 }
 
+// nlohmann's parser reports a number that overflows a double as out_of_range, not parse_error:
+// it must still reach the user as an input error naming the file (found by a fuzzing review).
+TEST(MachineJson, ANumberBeyondTheDoubleRangeIsAnInputError) {
+  const std::string e = error_of(R"({"format": "servotwin.machine/1", "ts": 1e999})");
+  EXPECT_THAT(e, HasSubstr("m.json"));
+  EXPECT_THAT(e, HasSubstr("does not fit a double"));
+}
+
 TEST(MachineJson, FormatIsChecked) {
   EXPECT_THAT(error_of(R"({"ts": 0.001})"), HasSubstr("missing \"format\""));
   EXPECT_THAT(error_of(R"({"format": "servotwin.machine/2", "ts": 0.001})"), HasSubstr("unsupported version"));

@@ -77,6 +77,11 @@ rapid::RegressionProblem axis_problem(const std::vector<NamedCapture>& captures,
 rapid::FitMetrics simulated_fit(const rapid::AxisModel& model, const std::vector<NamedCapture>& captures,
                                 const std::string& axis, int command_shift);
 
+/// Names of the axes (in the first capture's order) whose command moves in at least one capture:
+/// the axes an identification can say something about. A 3-axis capture of a one-axis program
+/// holds two axes at rest.
+std::vector<std::string> moving_axes(const std::vector<NamedCapture>& captures);
+
 /// The whole identification of one axis. With a shift search, core::InputError when the range is
 /// inverted or wider than 64 samples.
 AxisIdentification identify_axis(const std::vector<NamedCapture>& captures,
