@@ -39,6 +39,8 @@ void register_identify(CLI::App& app, Action& selected);
 void register_solve(CLI::App& app, Action& selected);
 void register_model(CLI::App& app, Action& selected);
 void register_predict(CLI::App& app, Action& selected);
+void register_frf(CLI::App& app, Action& selected);
+void register_fit(CLI::App& app, Action& selected);
 
 /// Progress line on stderr (suppressed by --quiet).
 template <typename... Args>

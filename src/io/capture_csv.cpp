@@ -18,11 +18,7 @@ namespace {
 
 using detail::Field;
 
-std::string lower(std::string_view s) {
-  std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return out;
-}
+using detail::lower;
 
 bool ends_with(std::string_view s, std::string_view suffix) {
   return s.size() > suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
@@ -161,15 +157,7 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
   std::vector<Field> fields;
 
   // Header: first line that is neither blank nor a comment.
-  bool have_header = false;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line_number == 1 && line.size() >= 3 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
-    if (detail::is_skippable_line(line)) continue;
-    have_header = true;
-    break;
-  }
-  if (!have_header) throw core::InputError({source, 0, 0, ""}, "empty file: expected a header row with column names");
+  line_number = detail::read_header_line(in, source, line, "a header row with column names");
   const std::size_t header_line = line_number;
   detail::split_csv_line(line, fields);
   const std::size_t field_count = fields.size();
@@ -203,13 +191,7 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
   RowLines row_lines;
   std::size_t rows = 0;
   double previous_t = 0.0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (detail::is_skippable_line(line)) continue;
-    detail::split_csv_line(line, fields);
-    if (fields.size() != field_count)
-      throw core::InputError({source, line_number, 0, ""},
-                             fmt::format("expected {} fields as in the header, found {}", field_count, fields.size()));
+  while (detail::next_data_row(in, source, line, line_number, fields, field_count)) {
     const core::SourceLocation where{source, line_number, 0, ""};
     for (const ColumnSink& sink : sinks) {
       const double value = detail::parse_number(fields[sink.index], where, sink.name) * sink.scale;

@@ -1,7 +1,9 @@
 #include "csv_lines.hpp"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
+#include <istream>
 
 namespace servotwin::io::detail {
 
@@ -45,6 +47,39 @@ void split_csv_line(std::string_view line, std::vector<Field>& fields) {
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
+}
+
+std::size_t read_header_line(std::istream& in, const std::string& source, std::string& line, std::string_view expected,
+                             const std::function<void(const std::string&, std::size_t)>& on_skipped) {
+  std::size_t line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line_number == 1 && line.size() >= 3 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
+    if (!is_skippable_line(line)) return line_number;
+    if (on_skipped) on_skipped(line, line_number);
+  }
+  throw core::InputError({source, line_number, 0, ""}, "empty file: expected " + std::string(expected));
+}
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+bool next_data_row(std::istream& in, const std::string& source, std::string& line, std::size_t& line_number,
+                   std::vector<Field>& fields, std::size_t field_count) {
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (is_skippable_line(line)) continue;
+    split_csv_line(line, fields);
+    if (fields.size() != field_count)
+      throw core::InputError({source, line_number, 0, ""}, "expected " + std::to_string(field_count) +
+                                                               " fields as in the header, found " +
+                                                               std::to_string(fields.size()));
+    return true;
+  }
+  return false;
 }
 
 bool is_skippable_line(std::string_view line) noexcept {

@@ -2,6 +2,8 @@
 // Private helpers shared by the CSV readers: field splitting and strict number parsing.
 
 #include <cstddef>
+#include <functional>
+#include <iosfwd>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -20,8 +22,26 @@ struct Field {
 /// double quotes are removed from each field.
 void split_csv_line(std::string_view line, std::vector<Field>& fields);
 
+/// ASCII lower case (column names are matched case-insensitively).
+std::string lower(std::string_view s);
+
 /// True for blank lines and `#` comment lines.
 bool is_skippable_line(std::string_view line) noexcept;
+
+/// Reads lines up to the header row (the first line that is neither blank nor a `#` comment),
+/// dropping a UTF-8 byte-order mark on the first line; `on_skipped(line, line_number)` sees each
+/// skipped line (e.g. to read `# key: value` comments). Leaves the header in `line` and returns its
+/// line number. core::InputError naming `source` ("empty file: expected <expected>") when there is
+/// no header.
+std::size_t read_header_line(std::istream& in, const std::string& source, std::string& line,
+                             std::string_view expected,
+                             const std::function<void(const std::string&, std::size_t)>& on_skipped = {});
+
+/// Reads the next data row (skipping blank and comment lines) into `fields`, counting lines in
+/// `line_number`; false at the end of the input. core::InputError at the line when the row does
+/// not have `field_count` fields, as the header.
+bool next_data_row(std::istream& in, const std::string& source, std::string& line, std::size_t& line_number,
+                   std::vector<Field>& fields, std::size_t field_count);
 
 /// Parses a finite decimal number occupying the whole field (optional leading '+').
 /// Throws core::InputError at `where` (column filled in from the field) otherwise.

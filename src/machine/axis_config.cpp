@@ -1,3 +1,4 @@
+#include "field_errors.hpp"
 #include "servotwin/machine/axis_config.hpp"
 
 #include <cctype>
@@ -20,16 +21,8 @@ std::string lower(std::string s) {
   return s;
 }
 
-std::string number(double v) {
-  std::ostringstream os;
-  os.precision(10);
-  os << v;
-  return os.str();
-}
-
-[[noreturn]] void fail(const std::string& field, const std::string& message) {
-  throw core::InputError(core::SourceLocation{"", 0, 0, field}, message);
-}
+using detail::fail;
+using detail::number;
 
 // Small checkers: each names the field and the expectation.
 void finite(double v, const std::string& field) {

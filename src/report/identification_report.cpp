@@ -2,6 +2,8 @@
 // and the simulated tracking error, as a report::Document.
 #include "servotwin/report/identification_report.hpp"
 
+#include "bode.hpp"
+
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -19,6 +21,9 @@
 namespace servotwin::report {
 
 namespace {
+
+using detail::magnitude_db;
+using detail::unwrapped_phase_deg;
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr std::size_t kFrequencyPoints = 800;
@@ -246,30 +251,6 @@ std::string bound_state(const rapid::Solution& sol, const std::string& variable)
     if (a.name == variable + "_max") return "at the upper bound (multiplier " + num(a.multiplier, 4) + ")";
   }
   return "inside";
-}
-
-/// Phase in degrees, continuous along the grid (the first point in (-180, 180]).
-std::vector<double> unwrapped_phase_deg(const std::vector<std::complex<double>>& g) {
-  std::vector<double> phase(g.size());
-  double previous = 0.0;
-  for (std::size_t i = 0; i < g.size(); ++i) {
-    const double p = std::arg(g[i]) * 180.0 / std::numbers::pi;
-    if (i == 0 || !std::isfinite(previous)) {
-      phase[i] = p;
-    } else {
-      double step = p - std::remainder(previous, 360.0);
-      step = std::remainder(step, 360.0);
-      phase[i] = previous + step;
-    }
-    previous = phase[i];
-  }
-  return phase;
-}
-
-std::vector<double> magnitude_db(const std::vector<std::complex<double>>& g) {
-  std::vector<double> db(g.size());
-  for (std::size_t i = 0; i < g.size(); ++i) db[i] = 20.0 * std::log10(std::abs(g[i]));
-  return db;
 }
 
 Section frequency_section(const vcnc::AxisIdentification& id, const rapid::AxisModel& model) {

@@ -1,0 +1,151 @@
+// `servotwin fit`: fit a plant model (two-mass, n modes, or automatic order) to a measured
+// frequency response and write plant_model.json.
+#include <cmath>
+#include <numbers>
+
+#include "command.hpp"
+#include "report_output.hpp"
+#include "servotwin/core/error.hpp"
+#include "servotwin/fit/fit.hpp"
+#include "servotwin/io/frf_csv.hpp"
+#include "servotwin/io/plant_model_json.hpp"
+#include "servotwin/report/fit_report.hpp"
+
+namespace servotwin::cli {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+struct FitArgs {
+  std::string frf;
+  std::string model = "two-mass";
+  std::string output_kind = "auto";
+  std::string rigid = "pole";
+  bool lag = false;
+  bool delay = false;
+  std::size_t max_modes = 4;
+  int max_iterations = 200;
+  std::string out;
+  std::string report;
+};
+
+/// "12.3 ± 0.4" (the ± part omitted when not identifiable).
+std::string pm(double value, double std) {
+  if (!std::isfinite(std)) return fmt::format("{:.5g} (std n/a)", value);
+  return fmt::format("{:.5g} ± {:.2g}", value, std);
+}
+
+void print_summary(const std::string& source, const fit::FitReport& r) {
+  const fit::FitResult& f = r.result;
+  const fit::PlantModel& m = f.model;
+  fmt::print("{}: {} points, {} output ({})\n", source, f.points, fit::to_string(m.output), r.output.note);
+  fmt::print("model: {} mode(s), rigid {}{}{}; {}\n", m.modes.size(), fit::to_string(m.rigid),
+             m.lag_pole_rad_s ? ", lag pole" : "", m.delay_s ? ", delay" : "", r.selection.criterion);
+  if (r.selection.method == "auto")
+    for (const auto& c : r.selection.candidates)
+      fmt::print("  n = {}: {} parameters, cost {:.4g}, score {:.4g}{}\n", c.modes, c.parameters, c.cost, c.score,
+                 c.converged ? (c.modes == r.selection.chosen ? "  <- chosen" : "") : "  (did not converge)");
+  fmt::print("fit: {} iterations from the {} start, {}; rms log error {:.3g} ({} weighting)\n", f.iterations,
+             f.initialization, f.message, f.rms_log_error, f.weighting);
+  fmt::print("  gain K          = {}\n", pm(f.gain.value, f.gain.std));
+  if (m.rigid == fit::RigidKind::kRealPole)
+    fmt::print("  rigid pole      = {} Hz\n", pm(f.rigid_pole_rad_s.value / kTwoPi, f.rigid_pole_rad_s.std / kTwoPi));
+  if (m.lag_pole_rad_s)
+    fmt::print("  lag pole        = {} Hz\n", pm(f.lag_pole_rad_s.value / kTwoPi, f.lag_pole_rad_s.std / kTwoPi));
+  if (m.delay_s) fmt::print("  delay           = {} s\n", pm(f.delay_s.value, f.delay_s.std));
+  for (std::size_t i = 0; i < f.mode_estimates.size(); ++i) {
+    const auto& u = f.mode_estimates[i];
+    fmt::print("  mode {}: antiresonance {} Hz, zeta {}\n", i + 1, pm(u.antiresonance_omega.value / kTwoPi, u.antiresonance_omega.std / kTwoPi),
+               pm(u.antiresonance_zeta.value, u.antiresonance_zeta.std));
+    fmt::print("          resonance     {} Hz, zeta {}\n", pm(u.resonance_omega.value / kTwoPi, u.resonance_omega.std / kTwoPi),
+               pm(u.resonance_zeta.value, u.resonance_zeta.std));
+  }
+  if (const auto& p = f.physical.parameters) {
+    fmt::print("physical two-mass parameters (input/output units of the data):\n");
+    fmt::print("  motor inertia Im = {}\n  load inertia  Il = {}\n  stiffness     k  = {}\n  damping       b  = {}\n"
+               "  ratio r = wn/wz  = {}   (zeta_p / (r zeta_z) = {:.3g}; 1 for a pure shaft damper)\n",
+               pm(p->motor_inertia.value, p->motor_inertia.std), pm(p->load_inertia.value, p->load_inertia.std),
+               pm(p->stiffness.value, p->stiffness.std), pm(p->damping.value, p->damping.std),
+               pm(p->resonance_ratio.value, p->resonance_ratio.std), p->damping_consistency);
+  } else {
+    fmt::print("physical parameters: none ({})\n", f.physical.note);
+  }
+}
+
+fit::FitOptions options_from(const FitArgs& a) {
+  fit::FitOptions o;
+  if (a.output_kind == "velocity")
+    o.output = fit::OutputChoice::kVelocity;
+  else if (a.output_kind == "position")
+    o.output = fit::OutputChoice::kPosition;
+  else
+    o.output = fit::OutputChoice::kDetect;
+  o.rigid = a.rigid == "integrator" ? fit::RigidKind::kIntegrator : fit::RigidKind::kRealPole;
+  o.lag = a.lag;
+  o.delay = a.delay;
+  o.max_modes = a.max_modes;
+  o.max_iterations = a.max_iterations;
+  return o;
+}
+
+int run(const FitArgs& a, const GlobalOptions& global) {
+  const auto start = std::chrono::steady_clock::now();
+  const fit::ModelRequest request = fit::parse_model_request(a.model);
+  const core::FrequencyResponse response = io::read_frf_file(a.frf);
+  const auto report_file = open_report(a.report, global);
+  fit::FitReport fitted;
+  try {
+    fitted = fit::fit_plant(response, request, options_from(a));
+  } catch (const core::InputError& e) {
+    // Point-level problems name "points[i]..."; say which file they are in.
+    if (e.where().field.rfind("points", 0) == 0) throw core::InputError({a.frf, 0, 0, e.where().field}, e.reason());
+    throw;
+  }
+  print_summary(a.frf, fitted);
+  if (!a.out.empty()) {
+    auto out = open_output(a.out, global);
+    out->stream() << io::plant_model_to_json(fitted).dump(2) << "\n";
+    out->commit();
+    progress(global, "wrote {} ({:.0f} ms)", a.out, elapsed_ms(start));
+  }
+  if (report_file) write_report(report::fit_report(response, fitted, a.frf), *report_file, global);
+  return kSuccess;
+}
+
+}  // namespace
+
+void register_fit(CLI::App& app, Action& selected) {
+  auto a = std::make_shared<FitArgs>();
+  CLI::App* cmd = app.add_subcommand("fit", "Fit a plant model (two-mass, n modes or automatic order) to a measured frequency response");
+  cmd->add_option("frf", a->frf, "Frequency-response CSV (servotwin.frf/1: freq_hz, re, im or mag_db, phase_deg)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--model", a->model,
+                  "two-mass (rigid mode + one mode, C5.7), modes:N (N flexible modes) or auto (order chosen by BIC, or by "
+                  "the noise level when the file has std)")
+      ->capture_default_str();
+  cmd->add_option("--output", a->output_kind, "Measured output: velocity, position, or auto (from the low-frequency slope)")
+      ->check(CLI::IsMember({"auto", "velocity", "position"}))
+      ->capture_default_str();
+  cmd->add_option("--rigid", a->rigid, "Rigid-body mode: pole (K/(s+a), viscous friction) or integrator (K/s)")
+      ->check(CLI::IsMember({"pole", "integrator"}))
+      ->capture_default_str();
+  cmd->add_flag("--lag", a->lag, "Also fit a lag pole 1/(s+tau2) (sampling, communication and actuator lag)");
+  cmd->add_flag("--delay", a->delay, "Also fit a pure delay exp(-sT)");
+  cmd->add_option("--max-modes", a->max_modes, "Largest number of modes tried by --model auto")
+      ->check(CLI::Range(1, 20))
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", a->max_iterations, "Levenberg-Marquardt iteration limit per start")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_option("-o,--out", a->out, "Write the model (servotwin.plant-model/1 JSON; - for stdout)");
+  add_report_option(*cmd, a->report);
+  set_examples(*cmd,
+               "  servotwin fit frf.csv -o plant_model.json --report fit.html\n"
+               "  servotwin fit frf.csv --model modes:2 --lag -o plant_model.json\n"
+               "  servotwin fit frf.csv --model auto --output velocity --rigid integrator\n");
+  cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });
+}
+
+}  // namespace servotwin::cli

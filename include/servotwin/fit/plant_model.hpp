@@ -1,0 +1,68 @@
+#pragma once
+/// \file
+/// Plant model classes for fitting measured frequency responses (seed catalog C5.7):
+///
+///   P(s) = K · R(s) · Π_i (s² + 2ζz_i ωz_i s + ωz_i²)/(s² + 2ζp_i ωp_i s + ωp_i²) · L(s) · e^{−sT} · O(s)
+///
+/// with the rigid mode R = 1/(s + a) (real pole, viscous friction) or 1/s (integrator), an
+/// optional lag L = 1/(s + τ2) (test-bed form, catalog A6; it lumps sampling, communication and
+/// actuator lag), an optional pure delay, and O = 1 for a velocity output or 1/s for a position
+/// output. Each mode is an antiresonance (complex zero pair) with its resonance (complex pole
+/// pair). The model is held in modal parameters; the transfer function is derived from them.
+/// Frequencies are in rad/s (design.md "Units").
+
+#include <complex>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "servotwin/core/transfer_function.hpp"
+
+namespace servotwin::fit {
+
+/// What the measured output is: velocity, or position (one more integrator).
+enum class OutputKind { kVelocity, kPosition };
+/// The rigid-body part: a real pole K/(s+a) or an integrator K/s.
+enum class RigidKind { kRealPole, kIntegrator };
+
+/// "velocity" / "position".
+[[nodiscard]] std::string to_string(OutputKind output);
+/// "pole" / "integrator".
+[[nodiscard]] std::string to_string(RigidKind rigid);
+
+/// Natural frequency and damping of a complex pair s² + 2ζωs + ω².
+struct ModalPair {
+  double omega_rad_s = 0.0;
+  double zeta = 0.0;
+};
+
+/// One flexible mode: the antiresonance (zeros) and resonance (poles). For a collocated
+/// (motor-side) measurement the antiresonance lies below the resonance.
+struct Mode {
+  ModalPair antiresonance;
+  ModalPair resonance;
+};
+
+/// A fitted or user-given plant model.
+struct PlantModel {
+  OutputKind output = OutputKind::kVelocity;
+  RigidKind rigid = RigidKind::kRealPole;
+  double gain = 1.0;                       ///< K (high-frequency asymptote K/s of a velocity model without lag)
+  double rigid_pole_rad_s = 0.0;           ///< a for kRealPole; ignored for kIntegrator
+  std::vector<Mode> modes;                 ///< ordered by increasing resonance frequency
+  std::optional<double> lag_pole_rad_s;    ///< τ2 of the lag 1/(s + τ2), when present
+  std::optional<double> delay_s;           ///< pure delay T, when present
+
+  /// P(jω).
+  [[nodiscard]] std::complex<double> response(double omega_rad_s) const noexcept;
+  /// The rational part num/den (the delay, if any, is not included). Denominator monic.
+  [[nodiscard]] core::TransferFunction transfer_function() const;
+  /// Number of free parameters of this structure (K, a, 4 per mode, τ2, T).
+  [[nodiscard]] std::size_t parameter_count() const noexcept;
+};
+
+/// Parameter count of a structure without building the model.
+[[nodiscard]] std::size_t parameter_count(std::size_t modes, RigidKind rigid, bool lag, bool delay) noexcept;
+
+}  // namespace servotwin::fit

@@ -1,0 +1,54 @@
+#pragma once
+/// \file
+/// The fitted plant model file "servotwin.plant-model/1" (written by `servotwin fit`):
+///
+///     {"format": "servotwin.plant-model/1",
+///      "model": {"type": "rigid"|"two-mass"|"multi-mode", "output": "velocity"|"position",
+///                "rigid": "pole"|"integrator", "gain", "gain_std",
+///                "rigid_pole_hz", "rigid_pole_hz_std"            (null for the integrator),
+///                "lag_pole_hz", "lag_pole_hz_std", "delay_s", "delay_s_std"   (null when absent),
+///                "numerator": [...], "denominator": [...]}       (s in rad/s, highest power first,
+///                                                                  delay excluded)
+///      "modes": [{"mode": 1, "kind": "antiresonance"|"resonance", "freq_hz", "zeta",
+///                 "freq_hz_std", "zeta_std"}, ...],             (two entries per mode)
+///      "physical": {"motor_inertia", "motor_inertia_std", "load_inertia", "load_inertia_std",
+///                   "stiffness", "stiffness_std", "damping", "damping_std",
+///                   "resonance_ratio", "resonance_ratio_std", "damping_consistency"} or null,
+///      "physical_note": "...",
+///      "fit": {"converged", "message", "initialization", "weighting", "points", "parameters",
+///              "iterations", "cost", "residual" (rms of |ln(P_model/P_meas)|), "sigma2"},
+///      "selection": {"method", "criterion", "chosen_modes", "candidates": [{"modes",
+///                    "parameters", "converged", "cost", "score"}],
+///                    "output_detection": {"output", "detected", "slope_db_per_decade", "note"}}}
+///
+/// Standard deviations that are not identifiable are written as null. The reader needs "format",
+/// "model" and "modes"; "numerator"/"denominator" must agree with the modal parameters
+/// (relative 1e-6), so a hand-edited file cannot silently mean two different plants.
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "servotwin/fit/fit.hpp"
+
+namespace servotwin::io {
+
+inline constexpr std::string_view kPlantModelFormat = "servotwin.plant-model/1";
+
+/// The whole report as a plant-model document.
+nlohmann::json plant_model_to_json(const fit::FitReport& report);
+
+/// What a plant-model file gives back.
+struct LoadedPlantModel {
+  fit::PlantModel model;
+  std::optional<fit::TwoMassParameters> physical;
+  std::string physical_note;
+};
+
+/// Reads a plant-model document; core::InputError names the source and the field ("modes[2].zeta").
+LoadedPlantModel parse_plant_model_json(std::string_view text, std::string_view source_name);
+/// Opens and reads a plant-model file.
+LoadedPlantModel load_plant_model(const std::string& path);
+
+}  // namespace servotwin::io

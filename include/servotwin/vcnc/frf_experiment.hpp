@@ -1,0 +1,95 @@
+#pragma once
+/// \file
+/// The virtual frequency-response experiment: the real-time identification block (frf::RfidBlock)
+/// drives a simulated flexible plant (machine::FlexiblePlant) sample by sample, exactly as a
+/// drive's cyclic task would step it against the real mechanics. Used by `servotwin frf measure`,
+/// the tests of the block's end-to-end behaviour and the frequency-identification study.
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "servotwin/core/frequency_response.hpp"
+#include "servotwin/frf/rfid_block.hpp"
+#include "servotwin/machine/flexible_plant.hpp"
+
+namespace servotwin::vcnc {
+
+/// What a user states about an experiment; everything else is derived (experiment_parameters).
+struct FrfExperimentSettings {
+  double f_begin_hz = 1.0;      ///< first frequency [Hz]
+  double f_end_hz = 500.0;      ///< last frequency [Hz]; below fs/10 so the 5th harmonic stays below Nyquist
+  std::size_t points = 30;      ///< listed measurement frequencies, logarithmically spaced, ends included (>= 2)
+  /// Excitation amplitude at the start (input units, e.g. N m). Empty: chosen from the plant so
+  /// that the response at f_begin stands 300 times above the measurement noise.
+  std::optional<double> amplitude;
+  /// Ceiling of the excitation amplitude. Empty: 100 x the initial amplitude.
+  std::optional<double> max_amplitude;
+  /// Allowed output range +-output_limit (abort outside). Empty: 50 x the output amplitude
+  /// expected at f_begin with the initial amplitude.
+  std::optional<double> output_limit;
+  double sweep_time_s = 8.0;    ///< time the logarithmic sweep alone takes from f_begin to f_end
+  double thd_threshold = 0.05;  ///< THD* of the amplitude adaptation
+  double max_time_s = 120.0;    ///< the simulation stops (and says so) after this much experiment time
+  frf::ObserverDesign observer; ///< estimator bandwidth
+  /// Semi-closed loop (C5.12) for velocity outputs: a proportional loop on the observer's DC
+  /// estimate A0 (not on the measured output, so the harmonics it measures are untouched) holds
+  /// the mean velocity at zero. Without it, switching the sine on leaves a free inertia with a
+  /// mean velocity that friction takes seconds to remove at the lowest frequencies. Its gain
+  /// gives a loop bandwidth of f_begin/4 on the plant's rigid inertia, well below the DC
+  /// channel's bandwidth (about 2.8 x f_begin), so loop and measurement do not interact.
+  bool hold_dc = true;
+};
+
+/// One sample of the experiment, for `--trace`.
+struct FrfTraceSample {
+  double t = 0.0;          ///< time since the start [s]
+  double mv = 0.0;         ///< actuator command
+  double pv = 0.0;         ///< measured output
+  double f_hz = 0.0;       ///< excitation frequency
+  double amplitude = 0.0;  ///< excitation amplitude
+  double thd = 0.0;
+  frf::RfidState state = frf::RfidState::kIdle;
+};
+
+/// The outcome of a run.
+struct FrfExperiment {
+  core::FrequencyResponse response;          ///< latched points, duration_s = experiment time
+  std::vector<frf::MeasuredPoint> points;    ///< in measurement order, with their kind
+  frf::RfidState final_state = frf::RfidState::kIdle;
+  frf::AbortReason abort_reason = frf::AbortReason::kNone;
+  bool timed_out = false;                    ///< max_time_s reached before the block finished
+  frf::RfidParameters parameters;            ///< what the block ran with
+  std::vector<FrfTraceSample> trace;         ///< every sample when asked for, else empty
+  double dc_gain = 0.0;                      ///< gain of the semi-closed loop (0 = open loop)
+};
+
+/// The block parameters for `plant` and `settings`: listed frequencies, sweep coefficient, the
+/// settling time from the plant's slowest lightly damped mode in the range, amplitudes and output
+/// range from the plant's linear model and noise level. core::InputError naming the setting
+/// ("--range-hz", "--points", "--amplitude", ...) when the request cannot be measured at the
+/// plant's sample period.
+frf::RfidParameters experiment_parameters(const machine::FlexiblePlant& plant, const FrfExperimentSettings& settings);
+
+/// Progress callback: (experiment time [s], points latched so far, current frequency [Hz]).
+using FrfProgress = std::function<void(double, std::size_t, double)>;
+
+/// Gain of the semi-closed loop for `plant` and `settings` (0 when hold_dc is off or the output is
+/// a position, which would need a stabilizing position loop the plant description lacks).
+double dc_hold_gain(const machine::FlexiblePlant& plant, const FrfExperimentSettings& settings);
+
+/// Runs the block against the plant from rest until it is done, aborts or max_time_s passes,
+/// with cv = -dc_gain A0 (0: open loop). The plant is reset first. `progress` (optional) is
+/// called about once per simulated second.
+FrfExperiment run_frf_experiment(machine::FlexiblePlant& plant, const frf::RfidParameters& parameters,
+                                 double max_time_s, bool keep_trace, double dc_gain = 0.0,
+                                 const FrfProgress& progress = {});
+
+/// "listed", "resonance", "antiresonance".
+std::string point_kind_name(frf::PointKind kind);
+/// "done", "aborted: output out of range", ...
+std::string outcome_text(const FrfExperiment& experiment);
+
+}  // namespace servotwin::vcnc

@@ -1,0 +1,41 @@
+#include "servotwin/frf/amplitude_adaptation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace servotwin::frf {
+
+void AmplitudeAdapter::reset() noexcept {
+  amplitude_ = std::clamp(law_.initial, 0.0, law_.maximum);
+  relay_ = false;
+  action_ = AmplitudeAction::kHold;
+}
+
+void AmplitudeAdapter::set_amplitude(double amplitude) noexcept {
+  amplitude_ = std::clamp(amplitude, 0.0, law_.maximum);
+}
+
+double AmplitudeAdapter::update(double thd, double usage, double omega_ts) noexcept {
+  if (thd > law_.thd_threshold + law_.thd_hysteresis) relay_ = true;
+  else if (thd < law_.thd_threshold - law_.thd_hysteresis) relay_ = false;
+  // NaN THD (no first harmonic yet) leaves the relay as it was.
+
+  const double periods = std::abs(omega_ts) / (2.0 * std::numbers::pi);  // fraction of a period per sample
+  const bool usage_unknown = !(usage == usage);  // NaN: be conservative, never increase
+  if (usage_unknown || usage >= law_.reduce_ratio) {
+    action_ = usage_unknown ? AmplitudeAction::kHold : AmplitudeAction::kDecrease;
+    if (!usage_unknown)
+      amplitude_ = std::min(amplitude_, std::max(law_.minimum, amplitude_ * std::pow(law_.reduce_per_period, periods)));
+  } else if (usage >= law_.hold_ratio * law_.reduce_ratio || !relay_ || amplitude_ >= law_.maximum) {
+    action_ = AmplitudeAction::kHold;
+  } else {
+    action_ = AmplitudeAction::kIncrease;
+    if (law_.proportional) amplitude_ *= std::pow(1.0 + law_.rate, periods);
+    else amplitude_ += law_.rate * law_.initial * periods;
+  }
+  amplitude_ = std::clamp(amplitude_, 0.0, law_.maximum);
+  return amplitude_;
+}
+
+}  // namespace servotwin::frf

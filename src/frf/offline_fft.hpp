@@ -1,0 +1,29 @@
+#pragma once
+// Private: real-input DFT of the offline estimators, on Eigen's FFT module (kissfft backend,
+// mixed radix 2/3/4/5 plus a generic butterfly, so any length works; lengths with a large prime
+// factor are slower, O(N·p)).
+
+#include <complex>
+#include <cstddef>
+#include <unsupported/Eigen/FFT>
+#include <vector>
+
+namespace servotwin::frf::detail {
+
+/// Computes X(k) = Σ x[n] e^{−j2πkn/N}, k = 0 … N/2, reusing its plan and buffers across calls
+/// of the same length.
+class RealDft {
+ public:
+  RealDft() { fft_.SetFlag(Eigen::FFT<double>::HalfSpectrum); }
+
+  /// `in` holds N samples; `out` receives N/2 + 1 lines (resized only when N changes).
+  void forward(const std::vector<double>& in, std::vector<std::complex<double>>& out) {
+    out.resize(in.size() / 2 + 1);
+    fft_.fwd(out.data(), in.data(), static_cast<Eigen::Index>(in.size()));
+  }
+
+ private:
+  Eigen::FFT<double> fft_;
+};
+
+}  // namespace servotwin::frf::detail

@@ -1,0 +1,203 @@
+#include "servotwin/io/plant_model_json.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include "json_reader.hpp"
+#include "servotwin/core/error.hpp"
+#include "servotwin/io/machine_json.hpp"
+
+namespace servotwin::io {
+
+namespace {
+
+using nlohmann::json;
+using detail::JsonObject;
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+/// NaN (not identifiable) becomes null.
+json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json coefficients(std::span<const double> c) { return json(std::vector<double>(c.begin(), c.end())); }
+
+std::string model_type(std::size_t modes) {
+  return modes == 0 ? "rigid" : modes == 1 ? "two-mass" : "multi-mode";
+}
+
+json physical_json(const fit::TwoMassParameters& p) {
+  json j;
+  const auto put = [&](const char* name, const fit::Estimate& e) {
+    j[name] = e.value;
+    j[std::string(name) + "_std"] = number_or_null(e.std);
+  };
+  put("motor_inertia", p.motor_inertia);
+  put("load_inertia", p.load_inertia);
+  put("stiffness", p.stiffness);
+  put("damping", p.damping);
+  put("resonance_ratio", p.resonance_ratio);
+  j["damping_consistency"] = p.damping_consistency;
+  return j;
+}
+
+/// Coefficient lists agree within 1e-6 of the largest coefficient magnitude.
+bool agree(std::span<const double> expected, const json& given) {
+  if (given.size() != expected.size()) return false;
+  double scale = 0.0;
+  for (double v : expected) scale = std::max(scale, std::abs(v));
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    if (!given[i].is_number() || std::abs(given[i].get<double>() - expected[i]) > 1e-6 * scale) return false;
+  return true;
+}
+
+double positive(const JsonObject& o, std::string_view key) {
+  const double v = o.number(key);
+  if (!(v > 0.0)) o.fail(key, "expected a value > 0");
+  return v;
+}
+
+}  // namespace
+
+json plant_model_to_json(const fit::FitReport& report) {
+  const fit::FitResult& f = report.result;
+  const fit::PlantModel& m = f.model;
+  const core::TransferFunction tf = m.transfer_function();
+  json model = {{"type", model_type(m.modes.size())},
+                {"output", fit::to_string(m.output)},
+                {"rigid", fit::to_string(m.rigid)},
+                {"gain", m.gain},
+                {"gain_std", number_or_null(f.gain.std)}};
+  const bool pole = m.rigid == fit::RigidKind::kRealPole;
+  model["rigid_pole_hz"] = pole ? json(m.rigid_pole_rad_s / kTwoPi) : json(nullptr);
+  model["rigid_pole_hz_std"] = pole ? number_or_null(f.rigid_pole_rad_s.std / kTwoPi) : json(nullptr);
+  model["lag_pole_hz"] = m.lag_pole_rad_s ? json(*m.lag_pole_rad_s / kTwoPi) : json(nullptr);
+  model["lag_pole_hz_std"] = m.lag_pole_rad_s ? number_or_null(f.lag_pole_rad_s.std / kTwoPi) : json(nullptr);
+  model["delay_s"] = m.delay_s ? json(*m.delay_s) : json(nullptr);
+  model["delay_s_std"] = m.delay_s ? number_or_null(f.delay_s.std) : json(nullptr);
+  model["numerator"] = coefficients(tf.num().coefficients());
+  model["denominator"] = coefficients(tf.den().coefficients());
+
+  json modes = json::array();
+  for (std::size_t i = 0; i < m.modes.size(); ++i) {
+    const fit::ModeUncertainty& u = f.mode_estimates[i];
+    const auto entry = [&](const char* kind, const fit::ModalPair& p, const fit::Estimate& w, const fit::Estimate& z) {
+      return json{{"mode", i + 1},         {"kind", kind},
+                  {"freq_hz", p.omega_rad_s / kTwoPi}, {"zeta", p.zeta},
+                  {"freq_hz_std", number_or_null(w.std / kTwoPi)}, {"zeta_std", number_or_null(z.std)}};
+    };
+    modes.push_back(entry("antiresonance", m.modes[i].antiresonance, u.antiresonance_omega, u.antiresonance_zeta));
+    modes.push_back(entry("resonance", m.modes[i].resonance, u.resonance_omega, u.resonance_zeta));
+  }
+
+  json candidates = json::array();
+  for (const auto& c : report.selection.candidates)
+    candidates.push_back({{"modes", c.modes}, {"parameters", c.parameters}, {"converged", c.converged},
+                          {"cost", number_or_null(c.cost)}, {"score", number_or_null(c.score)}});
+  return json{
+      {"format", kPlantModelFormat},
+      {"model", model},
+      {"modes", modes},
+      {"physical", f.physical.parameters ? physical_json(*f.physical.parameters) : json(nullptr)},
+      {"physical_note", f.physical.note},
+      {"fit",
+       {{"converged", f.converged}, {"message", f.message}, {"initialization", f.initialization},
+        {"weighting", f.weighting}, {"points", f.points}, {"parameters", f.parameters}, {"iterations", f.iterations},
+        {"cost", f.cost}, {"residual", f.rms_log_error}, {"sigma2", number_or_null(f.sigma2)}}},
+      {"selection",
+       {{"method", report.selection.method},
+        {"criterion", report.selection.criterion},
+        {"chosen_modes", report.selection.chosen},
+        {"candidates", candidates},
+        {"output_detection",
+         {{"output", fit::to_string(report.output.output)},
+          {"detected", report.output.detected},
+          {"slope_db_per_decade", number_or_null(report.output.slope_db_per_decade)},
+          {"note", report.output.note}}}}}};
+}
+
+LoadedPlantModel parse_plant_model_json(std::string_view text, std::string_view source_name) {
+  const json document = detail::parse_json_text(text, source_name);
+  check_format(document, kPlantModelFormat, source_name);
+  const JsonObject root(document, "", source_name);
+  root.allow_only({"format", "model", "modes", "physical", "physical_note", "fit", "selection"});
+  const JsonObject m = root.object("model");
+  m.allow_only({"type", "output", "rigid", "gain", "gain_std", "rigid_pole_hz", "rigid_pole_hz_std", "lag_pole_hz",
+                "lag_pole_hz_std", "delay_s", "delay_s_std", "numerator", "denominator"});
+  LoadedPlantModel out;
+  fit::PlantModel& model = out.model;
+  const std::string output = m.string("output");
+  if (output != "velocity" && output != "position") m.fail("output", "expected \"velocity\" or \"position\", got \"" + output + "\"");
+  model.output = output == "velocity" ? fit::OutputKind::kVelocity : fit::OutputKind::kPosition;
+  const std::string rigid = m.string("rigid");
+  if (rigid != "pole" && rigid != "integrator") m.fail("rigid", "expected \"pole\" or \"integrator\", got \"" + rigid + "\"");
+  model.rigid = rigid == "pole" ? fit::RigidKind::kRealPole : fit::RigidKind::kIntegrator;
+  model.gain = m.number("gain");
+  if (model.gain == 0.0) m.fail("gain", "expected a non-zero gain");
+  if (model.rigid == fit::RigidKind::kRealPole) model.rigid_pole_rad_s = kTwoPi * positive(m, "rigid_pole_hz");
+  if (const auto lag = m.optional_number("lag_pole_hz")) {
+    if (!(*lag > 0.0)) m.fail("lag_pole_hz", "expected a value > 0 or null");
+    model.lag_pole_rad_s = kTwoPi * *lag;
+  }
+  if (const auto delay = m.optional_number("delay_s")) {
+    if (!(*delay >= 0.0)) m.fail("delay_s", "expected a value >= 0 or null");
+    model.delay_s = *delay;
+  }
+
+  const json& modes = document.at("modes");
+  if (!modes.is_array()) root.fail("modes", "expected an array");
+  if (modes.size() % 2 != 0) root.fail("modes", "expected an antiresonance and a resonance entry per mode");
+  for (std::size_t i = 0; i < modes.size(); i += 2) {
+    fit::Mode mode;
+    for (std::size_t k = 0; k < 2; ++k) {
+      const JsonObject e(modes[i + k], "modes[" + std::to_string(i + k) + "]", source_name);
+      e.allow_only({"mode", "kind", "freq_hz", "zeta", "freq_hz_std", "zeta_std"});
+      const std::string kind = e.string("kind");
+      const char* expected = k == 0 ? "antiresonance" : "resonance";
+      if (kind != expected) e.fail("kind", std::string("expected \"") + expected + "\" (entries alternate antiresonance, resonance), got \"" + kind + "\"");
+      const int number = e.integer_or("mode", static_cast<int>(i / 2 + 1));
+      if (number != static_cast<int>(i / 2 + 1)) e.fail("mode", "expected mode " + std::to_string(i / 2 + 1));
+      fit::ModalPair& p = k == 0 ? mode.antiresonance : mode.resonance;
+      p.omega_rad_s = kTwoPi * positive(e, "freq_hz");
+      p.zeta = positive(e, "zeta");
+    }
+    model.modes.push_back(mode);
+  }
+
+  const core::TransferFunction tf = model.transfer_function();
+  for (const char* key : {"numerator", "denominator"}) {
+    if (!m.has(key)) continue;
+    const json& given = m.array(key);
+    const auto expected = std::string(key) == "numerator" ? tf.num().coefficients() : tf.den().coefficients();
+    if (!agree(expected, given))
+      m.fail(key, "does not match the gain, poles and modes of the file (expected " + std::to_string(expected.size()) +
+                      " coefficients within 1e-6 relative)");
+  }
+
+  if (document.contains("physical") && !document.at("physical").is_null()) {
+    const JsonObject p = root.object("physical");
+    const auto read = [&](const char* name) {
+      return fit::Estimate{p.number(name), p.optional_number(std::string(name) + "_std").value_or(std::nan(""))};
+    };
+    fit::TwoMassParameters t;
+    t.motor_inertia = read("motor_inertia");
+    t.load_inertia = read("load_inertia");
+    t.stiffness = read("stiffness");
+    t.damping = read("damping");
+    t.resonance_ratio = read("resonance_ratio");
+    t.damping_consistency = p.number_or("damping_consistency", std::nan(""));
+    out.physical = t;
+  }
+  out.physical_note = root.string_or("physical_note", "");
+  return out;
+}
+
+LoadedPlantModel load_plant_model(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError({path, 0, 0, ""}, "cannot open the plant-model file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_plant_model_json(text.str(), path);
+}
+
+}  // namespace servotwin::io

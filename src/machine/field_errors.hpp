@@ -1,0 +1,24 @@
+#pragma once
+// Validation messages of the machine module (internal): numbers as people read them and errors
+// that name the offending field.
+#include <sstream>
+#include <string>
+
+#include "servotwin/core/error.hpp"
+
+namespace servotwin::machine::detail {
+
+/// A value with 10 significant digits, for messages.
+inline std::string number(double v) {
+  std::ostringstream os;
+  os.precision(10);
+  os << v;
+  return os.str();
+}
+
+/// core::InputError at `field` (no file: the io layer adds it).
+[[noreturn]] inline void fail(const std::string& field, const std::string& message) {
+  throw core::InputError(core::at_field(field), message);
+}
+
+}  // namespace servotwin::machine::detail

@@ -1,0 +1,169 @@
+#include "servotwin/vcnc/frf_experiment.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "servotwin/core/error.hpp"
+
+namespace servotwin::vcnc {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+core::InputError setting_error(const std::string& option, const std::string& message) {
+  return core::InputError(core::at_field(option), message);
+}
+
+void check_settings(const FrfExperimentSettings& s, double ts) {
+  const double f_max = 1.0 / (10.0 * ts);
+  if (!(s.f_begin_hz > 0.0) || !std::isfinite(s.f_end_hz) || !(s.f_end_hz > s.f_begin_hz))
+    throw setting_error("--range-hz", "expected 0 < begin < end, got " + std::to_string(s.f_begin_hz) + ":" +
+                                          std::to_string(s.f_end_hz) + " Hz");
+  if (!(s.f_end_hz < f_max))
+    throw setting_error("--range-hz", "the end frequency must stay below fs/10 = " + std::to_string(f_max) +
+                                          " Hz at the plant's sample period (the observer's 5th harmonic must "
+                                          "stay below Nyquist); got " + std::to_string(s.f_end_hz) + " Hz");
+  if (s.points < 2 || s.points > 10000) throw setting_error("--points", "expected 2..10000 points");
+  if (s.amplitude && !(*s.amplitude > 0.0 && std::isfinite(*s.amplitude)))
+    throw setting_error("--amplitude", "expected a positive finite amplitude");
+  if (s.max_amplitude && !(*s.max_amplitude > 0.0 && std::isfinite(*s.max_amplitude)))
+    throw setting_error("--max-amplitude", "expected a positive finite amplitude");
+  if (s.output_limit && !(*s.output_limit > 0.0 && std::isfinite(*s.output_limit)))
+    throw setting_error("--output-limit", "expected a positive finite limit");
+  if (!(s.sweep_time_s > 0.0 && std::isfinite(s.sweep_time_s)))
+    throw setting_error("--sweep-time", "expected a positive sweep time in seconds");
+  if (!(s.max_time_s > 0.0 && std::isfinite(s.max_time_s)))
+    throw setting_error("--max-time", "expected a positive time limit in seconds");
+}
+
+std::vector<double> log_spaced(double a, double b, std::size_t n) {
+  std::vector<double> out;
+  out.reserve(n);
+  const double step = std::log(b / a) / static_cast<double>(n - 1);
+  for (std::size_t i = 0; i + 1 < n; ++i) out.push_back(a * std::exp(step * static_cast<double>(i)));
+  out.push_back(b);
+  return out;
+}
+
+/// What the sensor cannot resolve: noise plus the quantization's uniform error.
+double noise_floor(const machine::PlantSettings& s) {
+  const double q = s.quantization / std::sqrt(12.0);
+  return std::max(std::hypot(s.noise_std, q), 1e-9);
+}
+
+}  // namespace
+
+frf::RfidParameters experiment_parameters(const machine::FlexiblePlant& plant, const FrfExperimentSettings& settings) {
+  const double ts = plant.ts();
+  check_settings(settings, ts);
+  const double w_begin = kTwoPi * settings.f_begin_hz;
+  const double w_end = kTwoPi * settings.f_end_hz;
+
+  const double gain_begin = std::abs(plant.transfer_function().frequency_response(w_begin));
+  if (!(gain_begin > 0.0) || !std::isfinite(gain_begin))
+    throw setting_error("--range-hz", "the plant does not respond at the start frequency");
+  const double floor = noise_floor(plant.config().settings);
+  const double amplitude = settings.amplitude.value_or(300.0 * floor / gain_begin);
+  const double max_amplitude = std::max(settings.max_amplitude.value_or(100.0 * amplitude), amplitude);
+  if (settings.max_amplitude && *settings.max_amplitude < amplitude)
+    throw setting_error("--max-amplitude", "must not be below the initial amplitude");
+
+  frf::RfidParameters p;
+  p.ts = ts;
+  p.omega_begin = w_begin;
+  p.omega_end = w_end;
+  p.initial_amplitude = amplitude;
+  p.max_amplitude = max_amplitude;
+  p.sweep_type = frf::SweepType::kLogarithmic;
+  p.sweep_rate = std::log(w_end / w_begin) / settings.sweep_time_s;
+  p.measurement_frequencies = log_spaced(w_begin, w_end, settings.points);
+  // Interior points must lie strictly inside the range for the block; the ends are measured as the
+  // sweep's first and last frequencies.
+  p.settling_time_s = 20.0 * ts;
+  p.max_settling_time_s = std::max(2.0, 8.0 / settings.f_begin_hz);
+  p.observer = settings.observer;
+  p.thd_threshold = settings.thd_threshold;
+  p.proportional_growth = true;  // antiresonances need many times A(t0)
+  p.amplitude_rate = 0.1;
+  p.fade_in_periods = 1.0;
+  p.thd_hysteresis = 0.4 * settings.thd_threshold;
+  p.noise_level = floor;
+  const double limit = settings.output_limit.value_or(50.0 * amplitude * gain_begin);
+  p.output_min = -limit;
+  p.output_max = limit;
+  return p;
+}
+
+double dc_hold_gain(const machine::FlexiblePlant& plant, const FrfExperimentSettings& settings) {
+  const machine::PlantOutput output = plant.config().settings.output;
+  const bool velocity = output == machine::PlantOutput::MotorVelocity || output == machine::PlantOutput::LoadVelocity;
+  if (!settings.hold_dc || !velocity) return 0.0;
+  // Rigid inertia seen at f_begin: |P(j w)| = 1/(J w) below the first antiresonance.
+  const double w = kTwoPi * settings.f_begin_hz;
+  const double gain = std::abs(plant.transfer_function().frequency_response(w));
+  if (!(gain > 0.0) || !std::isfinite(gain)) return 0.0;
+  const double inertia = 1.0 / (w * gain);
+  return inertia * w / 4.0;
+}
+
+FrfExperiment run_frf_experiment(machine::FlexiblePlant& plant, const frf::RfidParameters& parameters,
+                                 double max_time_s, bool keep_trace, double dc_gain, const FrfProgress& progress) {
+  FrfExperiment out;
+  out.parameters = parameters;
+  out.dc_gain = dc_gain;
+  frf::RfidBlock block(parameters);
+  plant.reset();
+  const double ts = plant.ts();
+  const auto max_samples = static_cast<long>(std::ceil(max_time_s / ts));
+  const long report_every = std::max(1L, std::lround(1.0 / ts));
+  if (keep_trace) out.trace.reserve(static_cast<std::size_t>(std::min(max_samples, 20'000'000L)));
+
+  double pv = plant.measure().y;
+  double cv = 0.0;
+  long k = 0;
+  for (; k < max_samples; ++k) {
+    const frf::RfidOutput o = block.step(true, pv, cv);
+    cv = -dc_gain * o.harmonics[0];
+    if (keep_trace)
+      out.trace.push_back({static_cast<double>(k) * ts, o.mv, pv, o.omega / kTwoPi, o.amplitude, o.thd, o.state});
+    if (o.state == frf::RfidState::kDone || o.state == frf::RfidState::kAborted) break;
+    pv = plant.step(o.mv).y;
+    if (progress && k % report_every == 0) progress(static_cast<double>(k) * ts, block.points().size(), o.omega / kTwoPi);
+  }
+  out.timed_out = k >= max_samples;
+  out.final_state = block.state();
+  out.abort_reason = block.abort_reason();
+  out.points.assign(block.points().begin(), block.points().end());
+  out.response = block.frequency_response();
+  out.response.duration_s = block.elapsed_s();
+  return out;
+}
+
+std::string point_kind_name(frf::PointKind kind) {
+  switch (kind) {
+    case frf::PointKind::kResonance: return "resonance";
+    case frf::PointKind::kAntiresonance: return "antiresonance";
+    case frf::PointKind::kListed: break;
+  }
+  return "listed";
+}
+
+std::string outcome_text(const FrfExperiment& e) {
+  if (e.timed_out) return "stopped at the time limit before the sweep ended";
+  switch (e.final_state) {
+    case frf::RfidState::kDone: return "done";
+    case frf::RfidState::kAborted:
+      switch (e.abort_reason) {
+        case frf::AbortReason::kOutputOutOfRange: return "aborted: the output left its allowed range";
+        case frf::AbortReason::kNonFiniteInput: return "aborted: the measured output was not finite";
+        case frf::AbortReason::kStoppedByUser: return "aborted: stopped";
+        case frf::AbortReason::kNone: break;
+      }
+      return "aborted";
+    default: return "unfinished";
+  }
+}
+
+}  // namespace servotwin::vcnc
