@@ -2,11 +2,14 @@
 // frequency response and write plant_model.json.
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <vector>
 
 #include "command.hpp"
 #include "report_output.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/fit/fit.hpp"
+#include "servotwin/fit/nonlinear.hpp"
 #include "servotwin/io/frf_csv.hpp"
 #include "servotwin/io/plant_model_json.hpp"
 #include "servotwin/report/fit_report.hpp"
@@ -28,6 +31,7 @@ struct FitArgs {
   int max_iterations = 200;
   std::string out;
   std::string report;
+  std::vector<std::string> amplitude_series;
 };
 
 /// "12.3 ± 0.4" (the ± part omitted when not identifiable).
@@ -73,6 +77,21 @@ void print_summary(const std::string& source, const fit::FitReport& r) {
   }
 }
 
+void print_nonlinear(const fit::NonlinearMechanics& n) {
+  fmt::print("nonlinear mechanics (describing functions, C5.10):\n");
+  if (n.coulomb.estimated)
+    fmt::print("  Coulomb friction M = {} (input units){}\n", pm(n.coulomb.level, n.coulomb.level_std),
+               n.coulomb.significant ? "" : "  not significant");
+  fmt::print("    {}\n", n.coulomb.note);
+  for (const auto& r : n.backlash.runs)
+    fmt::print("  amplitude {:.4g}: antiresonance {} Hz, shaft stiffness seen {:.5g}, twist {:.3g}\n", r.amplitude,
+               pm(r.antiresonance_hz, r.antiresonance_hz_std), r.effective_stiffness, r.twist_amplitude);
+  if (n.backlash.estimated && n.backlash.significant)
+    fmt::print("  backlash D = {:.4g} (position unit of the output: rad for rad/s data), shaft stiffness {:.5g}\n", n.backlash.width,
+               n.backlash.stiffness);
+  fmt::print("    {}\n", n.backlash.note);
+}
+
 fit::FitOptions options_from(const FitArgs& a) {
   fit::FitOptions o;
   if (a.output_kind == "velocity")
@@ -103,13 +122,21 @@ int run(const FitArgs& a, const GlobalOptions& global) {
     throw;
   }
   print_summary(a.frf, fitted);
+  std::optional<fit::NonlinearMechanics> nonlinear;
+  if (!a.amplitude_series.empty()) {
+    std::vector<core::FrequencyResponse> experiments{response};
+    for (const auto& path : a.amplitude_series) experiments.push_back(io::read_frf_file(path));
+    nonlinear = fit::analyze_nonlinear_mechanics(fitted, experiments, options_from(a));
+    print_nonlinear(*nonlinear);
+  }
   if (!a.out.empty()) {
     auto out = open_output(a.out, global);
-    out->stream() << io::plant_model_to_json(fitted).dump(2) << "\n";
+    out->stream() << io::plant_model_to_json(fitted, nonlinear ? &*nonlinear : nullptr).dump(2) << "\n";
     out->commit();
     progress(global, "wrote {} ({:.0f} ms)", a.out, elapsed_ms(start));
   }
-  if (report_file) write_report(report::fit_report(response, fitted, a.frf), *report_file, global);
+  if (report_file)
+    write_report(report::fit_report(response, fitted, a.frf, nonlinear ? &*nonlinear : nullptr), *report_file, global);
   return kSuccess;
 }
 
@@ -140,11 +167,16 @@ void register_fit(CLI::App& app, Action& selected) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("-o,--out", a->out, "Write the model (servotwin.plant-model/1 JSON; - for stdout)");
+  cmd->add_option("--amplitude-series", a->amplitude_series,
+                  "Responses of the same plant measured at other excitation amplitudes (the main file should be the "
+                  "largest): Coulomb friction and backlash from their describing functions")
+      ->check(CLI::ExistingFile);
   add_report_option(*cmd, a->report);
   set_examples(*cmd,
                "  servotwin fit frf.csv -o plant_model.json --report fit.html\n"
                "  servotwin fit frf.csv --model modes:2 --lag -o plant_model.json\n"
-               "  servotwin fit frf.csv --model auto --output velocity --rigid integrator\n");
+               "  servotwin fit frf.csv --model auto --output velocity --rigid integrator\n"
+               "  servotwin fit frf_2Nm.csv --delay --amplitude-series frf_0.25Nm.csv -o plant_model.json\n");
   cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });
 }
 

@@ -57,9 +57,26 @@ double positive(const JsonObject& o, std::string_view key) {
   return v;
 }
 
+json nonlinear_json(const fit::NonlinearMechanics& n) {
+  json runs = json::array();
+  for (const auto& r : n.backlash.runs)
+    runs.push_back({{"amplitude", r.amplitude},
+                    {"antiresonance_hz", r.antiresonance_hz},
+                    {"antiresonance_hz_std", number_or_null(r.antiresonance_hz_std)},
+                    {"effective_stiffness", r.effective_stiffness},
+                    {"twist_amplitude", r.twist_amplitude}});
+  return {{"coulomb",
+           {{"estimated", n.coulomb.estimated}, {"level", n.coulomb.level}, {"level_std", number_or_null(n.coulomb.level_std)},
+            {"significant", n.coulomb.significant}, {"frequencies", n.coulomb.frequencies},
+            {"points", n.coulomb.points}, {"note", n.coulomb.note}}},
+          {"backlash",
+           {{"estimated", n.backlash.estimated}, {"significant", n.backlash.significant}, {"width", n.backlash.width},
+            {"stiffness", n.backlash.stiffness}, {"note", n.backlash.note}, {"runs", runs}}}};
+}
+
 }  // namespace
 
-json plant_model_to_json(const fit::FitReport& report) {
+json plant_model_to_json(const fit::FitReport& report, const fit::NonlinearMechanics* nonlinear) {
   const fit::FitResult& f = report.result;
   const fit::PlantModel& m = f.model;
   const core::TransferFunction tf = m.transfer_function();
@@ -94,7 +111,7 @@ json plant_model_to_json(const fit::FitReport& report) {
   for (const auto& c : report.selection.candidates)
     candidates.push_back({{"modes", c.modes}, {"parameters", c.parameters}, {"converged", c.converged},
                           {"cost", number_or_null(c.cost)}, {"score", number_or_null(c.score)}});
-  return json{
+  json document{
       {"format", kPlantModelFormat},
       {"model", model},
       {"modes", modes},
@@ -114,13 +131,15 @@ json plant_model_to_json(const fit::FitReport& report) {
           {"detected", report.output.detected},
           {"slope_db_per_decade", number_or_null(report.output.slope_db_per_decade)},
           {"note", report.output.note}}}}}};
+  if (nonlinear) document["nonlinear"] = nonlinear_json(*nonlinear);
+  return document;
 }
 
 LoadedPlantModel parse_plant_model_json(std::string_view text, std::string_view source_name) {
   const json document = detail::parse_json_text(text, source_name);
   check_format(document, kPlantModelFormat, source_name);
   const JsonObject root(document, "", source_name);
-  root.allow_only({"format", "model", "modes", "physical", "physical_note", "fit", "selection"});
+  root.allow_only({"format", "model", "modes", "physical", "physical_note", "fit", "selection", "nonlinear"});
   const JsonObject m = root.object("model");
   m.allow_only({"type", "output", "rigid", "gain", "gain_std", "rigid_pole_hz", "rigid_pole_hz_std", "lag_pole_hz",
                 "lag_pole_hz_std", "delay_s", "delay_s_std", "numerator", "denominator"});

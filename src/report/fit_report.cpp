@@ -130,6 +130,33 @@ Section selection_section(const fit::FitReport& report) {
   return s;
 }
 
+Section nonlinear_section(const fit::NonlinearMechanics& n) {
+  Section s;
+  s.title = "Nonlinear mechanics";
+  s.text = "From responses measured at several excitation amplitudes, through the describing functions of Coulomb "
+           "friction (4M/(pi V), an extra damping that fades with the velocity amplitude V) and of a dead zone in the "
+           "shaft (a softer shaft at small twist: the antiresonance falls). " +
+           n.coulomb.note + ". " + n.backlash.note + ".";
+  Table t;
+  t.title = "Estimates";
+  t.header = {"quantity", "value", "significant"};
+  if (n.coulomb.estimated)
+    t.rows.push_back({"Coulomb friction M (input units)", with_std(n.coulomb.level, n.coulomb.level_std),
+                      n.coulomb.significant ? "yes" : "no"});
+  if (n.backlash.estimated)
+    t.rows.push_back({"backlash width D (position unit of the output: rad for rad/s data)",
+                      n.backlash.significant ? num(n.backlash.width, 4) : "none found", n.backlash.significant ? "yes" : "no"});
+  if (!t.rows.empty()) s.tables.push_back(std::move(t));
+  Table runs;
+  runs.title = "Antiresonance per amplitude";
+  runs.header = {"excitation amplitude", "antiresonance [Hz]", "shaft stiffness seen", "twist amplitude"};
+  for (const auto& r : n.backlash.runs)
+    runs.rows.push_back({num(r.amplitude, 4), with_std(r.antiresonance_hz, r.antiresonance_hz_std), num(r.effective_stiffness, 5),
+                         num(r.twist_amplitude, 3)});
+  if (!runs.rows.empty()) s.tables.push_back(std::move(runs));
+  return s;
+}
+
 Section response_section(const core::FrequencyResponse& measured, const fit::PlantModel& model) {
   Section s;
   s.title = "Frequency response";
@@ -186,7 +213,8 @@ Section response_section(const core::FrequencyResponse& measured, const fit::Pla
 
 }  // namespace
 
-Document fit_report(const core::FrequencyResponse& measured, const fit::FitReport& report, const std::string& source) {
+Document fit_report(const core::FrequencyResponse& measured, const fit::FitReport& report, const std::string& source,
+                    const fit::NonlinearMechanics* nonlinear) {
   if (measured.points.empty()) throw core::InputError(core::at_field("points"), "the frequency response has no points");
   Document doc;
   doc.title = "servotwin fit: plant model";
@@ -197,6 +225,7 @@ Document fit_report(const core::FrequencyResponse& measured, const fit::FitRepor
   doc.sections.push_back(modes_section(report));
   doc.sections.push_back(physical_section(report));
   doc.sections.push_back(selection_section(report));
+  if (nonlinear) doc.sections.push_back(nonlinear_section(*nonlinear));
   doc.sections.push_back(response_section(measured, report.result.model));
   return doc;
 }

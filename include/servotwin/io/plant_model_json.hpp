@@ -17,6 +17,12 @@
 ///      "physical_note": "...",
 ///      "fit": {"converged", "message", "initialization", "weighting", "points", "parameters",
 ///              "iterations", "cost", "residual" (rms of |ln(P_model/P_meas)|), "sigma2"},
+///      "nonlinear": {"coulomb": {"estimated", "level", "level_std", "significant", "frequencies",
+///                                "points", "note"},
+///                    "backlash": {"estimated", "significant", "width", "stiffness", "note",
+///                                 "runs": [{"amplitude", "antiresonance_hz", "antiresonance_hz_std",
+///                                           "effective_stiffness", "twist_amplitude"}]}}
+///                   (only when responses at several amplitudes were given; read back as a record),
 ///      "selection": {"method", "criterion", "chosen_modes", "candidates": [{"modes",
 ///                    "parameters", "converged", "cost", "score"}],
 ///                    "output_detection": {"output", "detected", "slope_db_per_decade", "note"}}}
@@ -31,13 +37,14 @@
 #include <string_view>
 
 #include "servotwin/fit/fit.hpp"
+#include "servotwin/fit/nonlinear.hpp"
 
 namespace servotwin::io {
 
 inline constexpr std::string_view kPlantModelFormat = "servotwin.plant-model/1";
 
 /// The whole report as a plant-model document.
-nlohmann::json plant_model_to_json(const fit::FitReport& report);
+nlohmann::json plant_model_to_json(const fit::FitReport& report, const fit::NonlinearMechanics* nonlinear = nullptr);
 
 /// What a plant-model file gives back.
 struct LoadedPlantModel {

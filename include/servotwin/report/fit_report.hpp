@@ -8,6 +8,7 @@
 
 #include "servotwin/core/frequency_response.hpp"
 #include "servotwin/fit/fit.hpp"
+#include "servotwin/fit/nonlinear.hpp"
 #include "servotwin/report/document.hpp"
 
 namespace servotwin::report {
@@ -19,11 +20,14 @@ namespace servotwin::report {
 ///  - "Physical parameters": motor and load inertia, stiffness, damping, resonance ratio (± std) or
 ///    the reason there are none;
 ///  - "Model order": the criterion and every candidate's cost and score;
+///  - "Nonlinear mechanics" (when `nonlinear` is given): Coulomb friction and backlash with the
+///    antiresonance per amplitude;
 ///  - "Frequency response": Bode magnitude and phase of the measured points (as measured) and of the
 ///    fitted model on a dense logarithmic grid over the measured range (delay included), and the
 ///    relative error |P_model/P_meas - 1| per point with the point's relative standard deviation
 ///    when the data carry one.
 /// `source` names the measured file in the subtitle. core::InputError when the response is empty.
-Document fit_report(const core::FrequencyResponse& measured, const fit::FitReport& report, const std::string& source);
+Document fit_report(const core::FrequencyResponse& measured, const fit::FitReport& report, const std::string& source,
+                    const fit::NonlinearMechanics* nonlinear = nullptr);
 
 }  // namespace servotwin::report
