@@ -197,9 +197,9 @@ struct MeasureArgs {
   std::string range = "1:500";
   std::size_t points = 30;
   std::optional<double> amplitude, max_amplitude, output_limit;
-  double sweep_time = 8.0;
+  double sweep_time = 0.0;
   double thd = 0.05;
-  double max_time = 120.0;
+  double max_time = 0.0;
   bool open_loop = false;
   std::string out;
   std::string trace;
@@ -285,7 +285,7 @@ int run_measure(const MeasureArgs& a, const GlobalOptions& global) {
     if (t >= 1.0 && std::fmod(t, 5.0) < 1.0) progress(global, "  t = {:.0f} s: {} points, at {:.1f} Hz", t, points, f_hz);
   };
   const vcnc::FrfExperiment e =
-      vcnc::run_frf_experiment(plant, parameters, settings.max_time_s, trace_out != nullptr, dc_gain, report);
+      vcnc::run_frf_experiment(plant, parameters, vcnc::time_limit(settings), trace_out != nullptr, dc_gain, report);
   print_measurement(config.name.empty() ? a.plant : config.name, e);
   if (e.response.points.size() < 2)
     throw core::InputError(core::at_field(a.plant), "the experiment " + vcnc::outcome_text(e) + " with fewer than 2 points");
@@ -317,9 +317,12 @@ void add_measure(CLI::App& frf, Action& selected) {
   cmd->add_option("--amplitude", a->amplitude, "Initial excitation amplitude (default: 300 x the noise at the start)");
   cmd->add_option("--max-amplitude", a->max_amplitude, "Ceiling of the excitation amplitude (default: 100 x initial)");
   cmd->add_option("--output-limit", a->output_limit, "Allowed output range +-LIMIT; the block stops outside it");
-  cmd->add_option("--sweep-time", a->sweep_time, "Time the logarithmic sweep alone takes [s]")->capture_default_str();
+  cmd->add_option("--sweep-time", a->sweep_time,
+                  "Time the logarithmic sweep alone takes [s] (default: max(8 s, 8 periods of the first frequency))");
   cmd->add_option("--thd", a->thd, "THD threshold of the amplitude adaptation")->capture_default_str();
-  cmd->add_option("--max-time", a->max_time, "Stop the simulation after this much experiment time [s]")->capture_default_str();
+  cmd->add_option("--max-time", a->max_time,
+                  "Stop the simulation after this much experiment time [s] (default: max(120 s, 200 periods of the "
+                  "first frequency + 4 sweep times))");
   cmd->add_flag("--open-loop", a->open_loop, "No semi-closed loop on the DC estimate (velocity outputs)");
   cmd->add_option("-o", a->out, "Frequency-response CSV to write ('-' = stdout)")->required();
   cmd->add_option("--trace", a->trace, "Also write every sample (t, mv, pv, f_hz, amplitude, thd, state) as CSV");

@@ -32,10 +32,10 @@ void check_settings(const FrfExperimentSettings& s, double ts) {
     throw setting_error("--max-amplitude", "expected a positive finite amplitude");
   if (s.output_limit && !(*s.output_limit > 0.0 && std::isfinite(*s.output_limit)))
     throw setting_error("--output-limit", "expected a positive finite limit");
-  if (!(s.sweep_time_s > 0.0 && std::isfinite(s.sweep_time_s)))
-    throw setting_error("--sweep-time", "expected a positive sweep time in seconds");
-  if (!(s.max_time_s > 0.0 && std::isfinite(s.max_time_s)))
-    throw setting_error("--max-time", "expected a positive time limit in seconds");
+  if (!(s.sweep_time_s >= 0.0 && std::isfinite(s.sweep_time_s)))
+    throw setting_error("--sweep-time", "expected a positive sweep time in seconds (0 = automatic)");
+  if (!(s.max_time_s >= 0.0 && std::isfinite(s.max_time_s)))
+    throw setting_error("--max-time", "expected a positive time limit in seconds (0 = automatic)");
 }
 
 std::vector<double> log_spaced(double a, double b, std::size_t n) {
@@ -53,7 +53,29 @@ double noise_floor(const machine::PlantSettings& s) {
   return std::max(std::hypot(s.noise_std, q), 1e-9);
 }
 
+/// Largest |P(j w)| of the plant's linear model over [w_begin, w_end] (log grid): the default output
+/// range must leave room for the resonances, not just for the first frequency.
+double peak_gain(const machine::FlexiblePlant& plant, double w_begin, double w_end) {
+  const core::TransferFunction tf = plant.transfer_function();
+  double peak = 0.0;
+  constexpr int kGrid = 2000;
+  for (int i = 0; i <= kGrid; ++i) {
+    const double w = w_begin * std::pow(w_end / w_begin, static_cast<double>(i) / kGrid);
+    const double g = std::abs(tf.frequency_response(w));
+    if (std::isfinite(g)) peak = std::max(peak, g);
+  }
+  return peak;
+}
+
 }  // namespace
+
+double sweep_time(const FrfExperimentSettings& s) {
+  return s.sweep_time_s > 0.0 ? s.sweep_time_s : std::max(8.0, 8.0 / s.f_begin_hz);
+}
+
+double time_limit(const FrfExperimentSettings& s) {
+  return s.max_time_s > 0.0 ? s.max_time_s : std::max(120.0, 200.0 / s.f_begin_hz + 4.0 * sweep_time(s));
+}
 
 frf::RfidParameters experiment_parameters(const machine::FlexiblePlant& plant, const FrfExperimentSettings& settings) {
   const double ts = plant.ts();
@@ -77,7 +99,7 @@ frf::RfidParameters experiment_parameters(const machine::FlexiblePlant& plant, c
   p.initial_amplitude = amplitude;
   p.max_amplitude = max_amplitude;
   p.sweep_type = frf::SweepType::kLogarithmic;
-  p.sweep_rate = std::log(w_end / w_begin) / settings.sweep_time_s;
+  p.sweep_rate = std::log(w_end / w_begin) / sweep_time(settings);
   p.measurement_frequencies = log_spaced(w_begin, w_end, settings.points);
   // Interior points must lie strictly inside the range for the block; the ends are measured as the
   // sweep's first and last frequencies.
@@ -90,7 +112,7 @@ frf::RfidParameters experiment_parameters(const machine::FlexiblePlant& plant, c
   p.fade_in_periods = 1.0;
   p.thd_hysteresis = 0.4 * settings.thd_threshold;
   p.noise_level = floor;
-  const double limit = settings.output_limit.value_or(50.0 * amplitude * gain_begin);
+  const double limit = settings.output_limit.value_or(20.0 * amplitude * peak_gain(plant, w_begin, w_end));
   p.output_min = -limit;
   p.output_max = limit;
   return p;
@@ -102,8 +124,13 @@ double dc_hold_gain(const machine::FlexiblePlant& plant, const FrfExperimentSett
   if (!settings.hold_dc || !velocity) return 0.0;
   // Rigid inertia seen at f_begin: |P(j w)| = 1/(J w) below the first antiresonance.
   const double w = kTwoPi * settings.f_begin_hz;
-  const double gain = std::abs(plant.transfer_function().frequency_response(w));
+  const core::TransferFunction tf = plant.transfer_function();
+  const double gain = std::abs(tf.frequency_response(w));
   if (!(gain > 0.0) || !std::isfinite(gain)) return 0.0;
+  // Only an integrating plant (a free inertia: |P| grows like 1/w below f_begin) keeps the mean
+  // velocity a switched-on sine gives it; a plant with a finite gain there settles by itself, and a
+  // loop designed for an inertia would only disturb it.
+  if (std::abs(tf.frequency_response(w / 10.0)) < 5.0 * gain) return 0.0;
   const double inertia = 1.0 / (w * gain);
   return inertia * w / 4.0;
 }

@@ -31,7 +31,7 @@ core::FrequencyResponse measure_at(double amplitude, double backlash) {
   s.amplitude = amplitude;
   s.max_amplitude = amplitude;  // fixed amplitude: the series is what is compared
   s.output_limit = 1e4;
-  const auto experiment = vcnc::run_frf_experiment(plant, vcnc::experiment_parameters(plant, s), s.max_time_s, false,
+  const auto experiment = vcnc::run_frf_experiment(plant, vcnc::experiment_parameters(plant, s), vcnc::time_limit(s), false,
                                                    vcnc::dc_hold_gain(plant, s));
   EXPECT_EQ(experiment.final_state, frf::RfidState::kDone) << vcnc::outcome_text(experiment);
   return experiment.response;

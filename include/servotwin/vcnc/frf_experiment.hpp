@@ -27,12 +27,17 @@ struct FrfExperimentSettings {
   std::optional<double> amplitude;
   /// Ceiling of the excitation amplitude. Empty: 100 x the initial amplitude.
   std::optional<double> max_amplitude;
-  /// Allowed output range +-output_limit (abort outside). Empty: 50 x the output amplitude
-  /// expected at f_begin with the initial amplitude.
+  /// Allowed output range +-output_limit (abort outside). Empty: 20 x the largest output
+  /// amplitude the initial amplitude gives over the range (the plant's linear model), so the
+  /// amplitude adaptation meets the range protection before the limit.
   std::optional<double> output_limit;
-  double sweep_time_s = 8.0;    ///< time the logarithmic sweep alone takes from f_begin to f_end
+  /// Time the logarithmic sweep alone takes from f_begin to f_end [s]; 0: max(8 s, 8 periods of
+  /// f_begin), so the sweep never outruns the observer at the lowest frequencies.
+  double sweep_time_s = 0.0;
   double thd_threshold = 0.05;  ///< THD* of the amplitude adaptation
-  double max_time_s = 120.0;    ///< the simulation stops (and says so) after this much experiment time
+  /// The simulation stops (and says so) after this much experiment time [s]; 0: max(120 s,
+  /// 200 periods of f_begin + 4 sweep times) — a point needs a few periods of its frequency.
+  double max_time_s = 0.0;
   frf::ObserverDesign observer; ///< estimator bandwidth
   /// Semi-closed loop (C5.12) for velocity outputs: a proportional loop on the observer's DC
   /// estimate A0 (not on the measured output, so the harmonics it measures are untouched) holds
@@ -76,8 +81,13 @@ frf::RfidParameters experiment_parameters(const machine::FlexiblePlant& plant, c
 /// Progress callback: (experiment time [s], points latched so far, current frequency [Hz]).
 using FrfProgress = std::function<void(double, std::size_t, double)>;
 
-/// Gain of the semi-closed loop for `plant` and `settings` (0 when hold_dc is off or the output is
-/// a position, which would need a stabilizing position loop the plant description lacks).
+/// The sweep time and the time limit with their automatic values resolved (see the settings).
+double sweep_time(const FrfExperimentSettings& settings);
+double time_limit(const FrfExperimentSettings& settings);
+
+/// Gain of the semi-closed loop for `plant` and `settings` (0 when hold_dc is off, when the output
+/// is a position, which would need a stabilizing position loop the plant description lacks, or when
+/// the plant does not integrate below f_begin: |P(j w/10)| < 5 |P(j w)|).
 double dc_hold_gain(const machine::FlexiblePlant& plant, const FrfExperimentSettings& settings);
 
 /// Runs the block against the plant from rest until it is done, aborts or max_time_s passes,
