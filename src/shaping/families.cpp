@@ -1,0 +1,293 @@
+#include "servotwin/shaping/families.hpp"
+
+#include <Eigen/Dense>
+#include <unsupported/Eigen/AutoDiff>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "servotwin/core/error.hpp"
+#include "shaper_checks.hpp"
+
+namespace servotwin::shaping {
+namespace {
+
+using std::numbers::pi;
+
+constexpr std::array<std::string_view, 8> kTypeNames = {"zv", "zvd", "zvdd", "mzv", "ei", "2hump_ei", "3hump_ei", "zv4"};
+
+Shaper normalized(std::string type, double omega, double zeta, std::vector<double> times,
+                  std::vector<double> amplitudes) {
+  double sum = 0.0;
+  for (double a : amplitudes) sum += a;
+  for (double& a : amplitudes) a /= sum;
+  return {std::move(type), omega, zeta, std::move(times), std::move(amplitudes)};
+}
+
+double damped(double omega, double zeta) { return omega * std::sqrt(1.0 - zeta * zeta); }
+
+// Impulses every half damped period with binomial weights times K^i: the ZV, ZVD, ZVDD family
+// (Singer–Seering), K = e^{−ζ ω_n T_d/2} = e^{−ζπ/√(1−ζ²)}.
+Shaper binomial_shaper(std::string type, double omega, double zeta, int order) {
+  detail::check_design_mode(omega, zeta);
+  const double half_period = pi / damped(omega, zeta);
+  const double k = std::exp(-zeta * omega * half_period);
+  std::vector<double> times;
+  std::vector<double> amplitudes;
+  double binomial = 1.0;
+  double k_power = 1.0;
+  for (int i = 0; i <= order; ++i) {
+    times.push_back(half_period * i);
+    amplitudes.push_back(binomial * k_power);
+    binomial = binomial * (order - i) / (i + 1);
+    k_power *= k;
+  }
+  return normalized(std::move(type), omega, zeta, std::move(times), std::move(amplitudes));
+}
+
+// ---- EI family: Newton on the defining conditions -------------------------------------------
+
+enum class Kind { kZero, kHump };
+struct Condition {
+  Kind kind;
+  int frequency;  ///< -1: the design frequency; otherwise index of a free critical frequency
+};
+
+// Unknowns (normalized frequency: ω_n = 1): amplitudes A_0..A_{n−1}, times t_1..t_{n−1}
+// (t_0 = 0), then the free critical frequencies. Equations: ΣA = 1, then per condition either
+// C = S = 0 (zero vibration) or V = V_tol and ∂(C² + S²)/∂ω = 0 (a hump of height V_tol).
+template <int Impulses, int Frequencies>
+struct EiProblem {
+  static constexpr int kUnknowns = 2 * Impulses - 1 + Frequencies;
+  static constexpr int kConditions = (kUnknowns - 1) / 2;
+  static_assert(2 * kConditions + 1 == kUnknowns);
+  using Vector = Eigen::Matrix<double, kUnknowns, 1>;
+  using Matrix = Eigen::Matrix<double, kUnknowns, kUnknowns>;
+
+  std::array<Condition, kConditions> conditions;
+  double zeta = 0.0;
+  double v_tol = 0.0;
+
+  template <typename Scalar>
+  void residuals(const Eigen::Matrix<Scalar, kUnknowns, 1>& x, Eigen::Matrix<Scalar, kUnknowns, 1>& f) const {
+    const double s = std::sqrt(1.0 - zeta * zeta);
+    Scalar sum = x[0];
+    for (int i = 1; i < Impulses; ++i) sum += x[i];
+    f[0] = sum - 1.0;
+    const Scalar& t_last = x[2 * Impulses - 2];
+    int row = 1;
+    for (const Condition& condition : conditions) {
+      const Scalar w = condition.frequency < 0 ? Scalar(1.0) : x[2 * Impulses - 1 + condition.frequency];
+      Scalar c(0.0), sn(0.0), c_w(0.0), s_w(0.0);
+      for (int i = 0; i < Impulses; ++i) {
+        const Scalar t = i == 0 ? Scalar(0.0) : x[Impulses + i - 1];
+        const Scalar lag = t_last - t;
+        const Scalar weight = x[i] * exp(-zeta * w * lag);
+        const Scalar phase = s * w * t;
+        const Scalar cos_p = cos(phase);
+        const Scalar sin_p = sin(phase);
+        c += weight * cos_p;
+        sn += weight * sin_p;
+        if (condition.kind == Kind::kHump) {
+          c_w += weight * (-zeta * lag * cos_p - s * t * sin_p);
+          s_w += weight * (-zeta * lag * sin_p + s * t * cos_p);
+        }
+      }
+      if (condition.kind == Kind::kZero) {
+        f[row++] = c;
+        f[row++] = sn;
+      } else {
+        f[row++] = sqrt(c * c + sn * sn) - v_tol;
+        f[row++] = c * c_w + sn * s_w;
+      }
+    }
+  }
+
+  Vector value(const Vector& x) const {
+    Vector f;
+    residuals(x, f);
+    return f;
+  }
+
+  void value_and_jacobian(const Vector& x, Vector& f, Matrix& jacobian) const {
+    using Dual = Eigen::AutoDiffScalar<Eigen::Matrix<double, kUnknowns, 1>>;
+    Eigen::Matrix<Dual, kUnknowns, 1> xd;
+    for (int i = 0; i < kUnknowns; ++i) xd[i] = Dual(x[i], kUnknowns, i);
+    Eigen::Matrix<Dual, kUnknowns, 1> fd;
+    residuals(xd, fd);
+    for (int j = 0; j < kUnknowns; ++j) {
+      f[j] = fd[j].value();
+      jacobian.row(j) = fd[j].derivatives().transpose();
+    }
+  }
+
+  // Times strictly increasing from 0 and positive frequencies: the domain of the conditions.
+  static bool in_domain(const Vector& x) {
+    double previous = 0.0;
+    for (int i = 1; i < Impulses; ++i) {
+      if (!(x[Impulses + i - 1] > previous)) return false;
+      previous = x[Impulses + i - 1];
+    }
+    for (int k = 0; k < Frequencies; ++k)
+      if (!(x[2 * Impulses - 1 + k] > 0.0)) return false;
+    return true;
+  }
+
+  // Damped Newton (step halving on the max-norm of the residuals).
+  bool newton(Vector& x) const {
+    Vector f;
+    Matrix jacobian;
+    for (int iteration = 0; iteration < 50; ++iteration) {
+      value_and_jacobian(x, f, jacobian);
+      const double norm = f.template lpNorm<Eigen::Infinity>();
+      if (norm < 1e-13) return true;
+      const Vector step = jacobian.partialPivLu().solve(-f);
+      if (!step.allFinite()) return false;
+      double scale = 1.0;
+      bool accepted = false;
+      for (int halving = 0; halving < 30 && !accepted; ++halving, scale *= 0.5) {
+        const Vector trial = x + scale * step;
+        if (!in_domain(trial)) continue;
+        if (value(trial).template lpNorm<Eigen::Infinity>() < norm) {
+          x = trial;
+          accepted = true;
+        }
+      }
+      if (!accepted) return value(x).template lpNorm<Eigen::Infinity>() < 1e-11;
+    }
+    return value(x).template lpNorm<Eigen::Infinity>() < 1e-11;
+  }
+};
+
+// Solves from the undamped closed form `start` (exact at ζ = 0) by continuation in ζ.
+template <int Impulses, int Frequencies>
+Shaper solve_ei_family(const char* type, const char* label, double omega, double zeta, double v_tol,
+                       const std::array<Condition, EiProblem<Impulses, Frequencies>::kConditions>& conditions,
+                       typename EiProblem<Impulses, Frequencies>::Vector start) {
+  EiProblem<Impulses, Frequencies> problem{conditions, 0.0, v_tol};
+  // Steps of at most 0.05 in ζ keep every Newton start inside the basin of the next solution.
+  const int steps = std::max(1, static_cast<int>(std::ceil(zeta / 0.05)));
+  for (int k = 1; k <= steps; ++k) {
+    problem.zeta = zeta * k / steps;
+    if (!problem.newton(start))
+      throw core::InputError(core::at_field("zeta"), std::string("no ") + label + " shaper satisfies its defining conditions at zeta = " +
+                                                         detail::show(problem.zeta) + " (design zeta " + detail::show(zeta) + ")");
+  }
+  std::vector<double> times{0.0};
+  std::vector<double> amplitudes;
+  for (int i = 0; i < Impulses; ++i) {
+    if (!(start[i] > 0.0))
+      throw core::InputError(core::at_field("zeta"), std::string("the ") + label + " shaper for zeta = " + detail::show(zeta) +
+                                                         " would need a negative impulse; use a lower damping or another family");
+    amplitudes.push_back(start[i]);
+    if (i > 0) times.push_back(start[Impulses + i - 1] / omega);
+  }
+  return normalized(type, omega, zeta, std::move(times), std::move(amplitudes));
+}
+
+void check_tolerance(double v_tol) {
+  if (!std::isfinite(v_tol) || v_tol <= 0.0 || v_tol >= 0.5)
+    throw core::InputError(core::at_field("v_tol"), "expected a vibration tolerance in (0, 0.5), got " + detail::show(v_tol));
+}
+
+}  // namespace
+
+std::string_view to_string(ShaperType type) noexcept { return kTypeNames[static_cast<std::size_t>(type)]; }
+
+ShaperType parse_shaper_type(std::string_view name, std::string_view field) {
+  for (std::size_t i = 0; i < kTypeNames.size(); ++i)
+    if (kTypeNames[i] == name) return static_cast<ShaperType>(i);
+  std::string names;
+  for (std::string_view known : kTypeNames) names += (names.empty() ? "" : ", ") + std::string(known);
+  throw core::InputError(core::at_field(std::string(field)),
+                         "unknown shaper type '" + std::string(name) + "'; expected one of " + names);
+}
+
+std::vector<std::string> shaper_type_names() { return {kTypeNames.begin(), kTypeNames.end()}; }
+
+Shaper zv_shaper(double omega, double zeta) { return binomial_shaper("zv", omega, zeta, 1); }
+Shaper zvd_shaper(double omega, double zeta) { return binomial_shaper("zvd", omega, zeta, 2); }
+Shaper zvdd_shaper(double omega, double zeta) { return binomial_shaper("zvdd", omega, zeta, 3); }
+
+Shaper mzv_shaper(double omega, double zeta) {
+  detail::check_design_mode(omega, zeta);
+  // Phases 0, 3π/4, 3π/2 of the damped oscillation; a1 = a2/√2 = a3 closes the vector triangle.
+  const double spacing = 0.75 * pi / damped(omega, zeta);
+  const double k = std::exp(-zeta * omega * spacing);
+  const double outer = 1.0 - 1.0 / std::numbers::sqrt2;
+  return normalized("mzv", omega, zeta, {0.0, spacing, 2.0 * spacing},
+                    {outer, (std::numbers::sqrt2 - 1.0) * k, outer * k * k});
+}
+
+Shaper ei_shaper(double omega, double zeta, double v_tol) {
+  detail::check_design_mode(omega, zeta);
+  check_tolerance(v_tol);
+  // Undamped closed form (Singer–Seering): A = [(1+V)/4, (1−V)/2, (1+V)/4] at 0, π, 2π (ω_n = 1);
+  // V(θ) = |(1+V)/2 cos θ + (1−V)/2| with θ = πω/ω_n has zeros at cos θ = −(1−V)/(1+V).
+  const double delta = std::acos((1.0 - v_tol) / (1.0 + v_tol));
+  EiProblem<3, 2>::Vector start;
+  start << (1.0 + v_tol) / 4.0, (1.0 - v_tol) / 2.0, (1.0 + v_tol) / 4.0, pi, 2.0 * pi, 1.0 - delta / pi, 1.0 + delta / pi;
+  return solve_ei_family<3, 2>("ei", "EI", omega, zeta, v_tol,
+                               {{{Kind::kHump, -1}, {Kind::kZero, 0}, {Kind::kZero, 1}}}, start);
+}
+
+Shaper two_hump_ei_shaper(double omega, double zeta, double v_tol) {
+  detail::check_design_mode(omega, zeta);
+  check_tolerance(v_tol);
+  // Undamped closed form (Singhose): X = (V²(√(1−V²)+1))^{1/3}, A1 = A4 = (3X² + 2X + 3V²)/(16X),
+  // A2 = A3 = 1/2 − A1 at 0, π, 2π, 3π. With u = cos(θ/2), V(θ) = |2u(4A1u² − 3A1 + A2)|: zeros
+  // at u² = (3A1 − A2)/(4A1) and humps at u² = (3A1 − A2)/(12A1).
+  const double x = std::cbrt(v_tol * v_tol * (std::sqrt(1.0 - v_tol * v_tol) + 1.0));
+  const double a1 = (3.0 * x * x + 2.0 * x + 3.0 * v_tol * v_tol) / (16.0 * x);
+  const double a2 = 0.5 - a1;
+  const double hump = 2.0 * std::acos(std::sqrt((3.0 * a1 - a2) / (12.0 * a1))) / pi;
+  const double zero = 2.0 * std::acos(std::sqrt((3.0 * a1 - a2) / (4.0 * a1))) / pi;
+  EiProblem<4, 4>::Vector start;
+  start << a1, a2, a2, a1, pi, 2.0 * pi, 3.0 * pi, hump, 2.0 - hump, zero, 2.0 - zero;
+  return solve_ei_family<4, 4>(
+      "2hump_ei", "2-hump EI", omega, zeta, v_tol,
+      {{{Kind::kZero, -1}, {Kind::kHump, 0}, {Kind::kHump, 1}, {Kind::kZero, 2}, {Kind::kZero, 3}}}, start);
+}
+
+Shaper three_hump_ei_shaper(double omega, double zeta, double v_tol) {
+  detail::check_design_mode(omega, zeta);
+  check_tolerance(v_tol);
+  // Undamped closed form (Singhose): A1 = A5 = (1 + 3V + 2√(2V(V+1)))/16, A2 = A4 = (1−V)/4,
+  // A3 = 1 − 2(A1 + A2) at 0, π, ..., 4π. With c = cos θ, V(θ) = |4A1c² + 2A2c + A3 − 2A1|: humps at
+  // c = −1 (the mode) and c = −A2/(4A1), zeros at the roots of the quadratic.
+  const double a1 = (1.0 + 3.0 * v_tol + 2.0 * std::sqrt(2.0 * v_tol * (v_tol + 1.0))) / 16.0;
+  const double a2 = (1.0 - v_tol) / 4.0;
+  const double a3 = 1.0 - 2.0 * (a1 + a2);
+  const double hump = std::acos(-a2 / (4.0 * a1)) / pi;
+  const double root = std::sqrt(4.0 * a2 * a2 - 16.0 * a1 * (a3 - 2.0 * a1));
+  const double zero_a = std::acos((-2.0 * a2 + root) / (8.0 * a1)) / pi;
+  const double zero_b = std::acos((-2.0 * a2 - root) / (8.0 * a1)) / pi;
+  EiProblem<5, 6>::Vector start;
+  start << a1, a2, a3, a2, a1, pi, 2.0 * pi, 3.0 * pi, 4.0 * pi, hump, 2.0 - hump, zero_a, 2.0 - zero_a, zero_b,
+      2.0 - zero_b;
+  return solve_ei_family<5, 6>("3hump_ei", "3-hump EI", omega, zeta, v_tol,
+                               {{{Kind::kHump, -1},
+                                 {Kind::kHump, 0},
+                                 {Kind::kHump, 1},
+                                 {Kind::kZero, 2},
+                                 {Kind::kZero, 3},
+                                 {Kind::kZero, 4},
+                                 {Kind::kZero, 5}}},
+                               start);
+}
+
+Shaper design_shaper(ShaperType type, double omega, double zeta, double v_tol) {
+  switch (type) {
+    case ShaperType::kZv: return zv_shaper(omega, zeta);
+    case ShaperType::kZvd: return zvd_shaper(omega, zeta);
+    case ShaperType::kZvdd: return zvdd_shaper(omega, zeta);
+    case ShaperType::kMzv: return mzv_shaper(omega, zeta);
+    case ShaperType::kEi: return ei_shaper(omega, zeta, v_tol);
+    case ShaperType::kTwoHumpEi: return two_hump_ei_shaper(omega, zeta, v_tol);
+    case ShaperType::kThreeHumpEi: return three_hump_ei_shaper(omega, zeta, v_tol);
+    case ShaperType::kZv4: break;
+  }
+  throw core::InputError(core::at_field("type"), "the zv4 shaper needs its p-parameters (zv4_shaper), not design_shaper");
+}
+
+}  // namespace servotwin::shaping
