@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages servotwin needs that are not installed yet.
-#   scripts/install-deps.sh          build dependencies (compiler, CMake, Eigen, CLI11, fmt, JSON, and
+#   scripts/install-deps.sh          build dependencies (compiler, CMake, Eigen, CLI11, fmt, JSON, GLPK, and
 #                                    npm, which fetches the charting library of the HTML reports)
 #   scripts/install-deps.sh --test   plus GoogleTest/GoogleMock, Google Benchmark and Chromium (the
 #                                    reports are checked in headless Chromium)
 #   scripts/install-deps.sh --fuzz   plus clang for the libFuzzer targets
 set -euo pipefail
 
-packages=(g++ make cmake libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev)
+packages=(g++ make cmake libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev libglpk-dev)
 # npm may also come with a Node.js that is not Debian's (whose package then provides and conflicts
 # with Debian's npm): only install Debian's when there is no npm at all.
 command -v npm >/dev/null || packages+=(npm)
