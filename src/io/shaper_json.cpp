@@ -53,7 +53,7 @@ LoadedShaper parse_shaper_json(std::string_view text, std::string_view source_na
   check_format(document, kShaperFormat, source_name);
   const JsonObject o(document, "", source_name);
   o.allow_only({"format", "type", "freq_hz", "zeta", "times_s", "amplitudes", "duration_s", "residual_at_design",
-                "parameters", "ts", "robustness"});
+                "parameters", "ts", "robustness", "alternatives", "reasons"});
   LoadedShaper loaded;
   shaping::Shaper& s = loaded.shaper;
   s.type = o.string("type");

@@ -9,7 +9,9 @@
 ///    optional "ts": sample period the shaper was designed for [s],
 ///    optional "robustness": {"band_level": .., "band_low_hz": .., "band_high_hz": ..,
 ///                            "band_width_normalized": .., "smoothing": .., "smoothing_accel": ..,
-///                            "smoothing_scv": ..}}
+///                            "smoothing_scv": ..},
+///    optional "alternatives": [...], "reasons": [...] (written by `shaper select`: the runners-up
+///    and why the recommendation won; informative, not read back)}
 ///
 /// freq_hz is the design frequency in Hz (the library works in rad/s). The reader checks: the
 /// format's major version, required members, finite numbers, times starting at 0 and strictly
