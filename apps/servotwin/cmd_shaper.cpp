@@ -5,6 +5,9 @@
 
 #include "command.hpp"
 #include "shaper_apply.hpp"
+#include "shaper_compare.hpp"
+#include "shaper_multimode.hpp"
+#include "shaper_select.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/shaper_json.hpp"
 #include "servotwin/shaping/families.hpp"
@@ -163,10 +166,13 @@ void add_design(CLI::App& shaper, Action& selected) {
 }  // namespace
 
 void register_shaper(CLI::App& app, Action& selected) {
-  auto* shaper = app.add_subcommand("shaper", "Input shapers: design one, apply one to a trajectory");
+  auto* shaper = app.add_subcommand("shaper", "Input shapers: design, apply to a trajectory, select from a measured spectrum or a fitted model, compare, multi-mode synthesis");
   shaper->require_subcommand(1);
   add_design(*shaper, selected);
   add_apply(*shaper, selected);
+  add_select(*shaper, selected);
+  add_compare(*shaper, selected);
+  add_multimode(*shaper, selected);
 }
 
 }  // namespace servotwin::cli
