@@ -9,7 +9,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <iterator>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -17,6 +16,7 @@
 #include <vector>
 
 #include "servotwin/core/error.hpp"
+#include "servotwin/io/shaped_csv.hpp"
 #include "servotwin/io/shaper_json.hpp"
 #include "servotwin/io/signal_csv.hpp"
 #include "servotwin/shaping/discretization.hpp"
@@ -53,48 +53,6 @@ CommandColumns command_columns(const io::SignalTable& table) {
     throw core::InputError(core::SourceLocation{table.source, 1, 0, ""},
                            "expected at least one `<axis>_cmd` column (a trajectory CSV: t, x_cmd, ...)");
   return out;
-}
-
-// Decimals at which t0 and ts are exact (so 0.003 is not printed as 0.0030000000000000001);
-// -1 = shortest round-trip.
-int time_decimals(double t0, double ts) {
-  for (int d = 0; d < 12; ++d) {
-    const double scale = std::pow(10.0, d);
-    const auto whole = [scale](double v) {
-      const double scaled = v * scale;
-      return std::abs(scaled - std::round(scaled)) <= 1e-9 * std::abs(scaled);
-    };
-    if (whole(ts) && whole(t0)) return d;
-  }
-  return -1;
-}
-
-void write_shaped_csv(std::ostream& out, double t0, double ts, const CommandColumns& commanded,
-                      const shaping::Columns& shaped, const std::vector<double>& deviation) {
-  fmt::memory_buffer buffer;
-  auto it = std::back_inserter(buffer);
-  fmt::format_to(it, "t");
-  for (const auto& axis : commanded.axes) fmt::format_to(it, ",{}_cmd", axis);
-  for (const auto& axis : commanded.axes) fmt::format_to(it, ",{}_shaped", axis);
-  fmt::format_to(it, ",deviation\n");
-  const int decimals = time_decimals(t0, ts);
-  const std::size_t n = commanded.positions.front().size();
-  for (std::size_t k = 0; k < deviation.size(); ++k) {
-    const double t = t0 + static_cast<double>(k) * ts;
-    if (decimals >= 0)
-      fmt::format_to(it, "{:.{}f}", t, decimals);
-    else
-      fmt::format_to(it, "{}", t);
-    // Past the end of the command the axes hold the end point while the shaped command settles.
-    for (const auto& column : commanded.positions) fmt::format_to(it, ",{}", column[std::min(k, n - 1)]);
-    for (const auto& column : shaped) fmt::format_to(it, ",{}", column[k]);
-    fmt::format_to(it, ",{}\n", deviation[k]);
-    if (buffer.size() > (1U << 16)) {
-      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-      buffer.clear();
-    }
-  }
-  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
 }
 
 // The reader checks --ts as a sample rate; say it in the user's terms.
@@ -134,7 +92,7 @@ int run_apply(const ApplyArgs& a, const GlobalOptions& global) {
   const shaping::PathDeviation deviation = shaping::path_deviation(commanded.positions, shaped, discrete.max_delay());
 
   auto out = open_output(a.output, global);
-  write_shaped_csv(out->stream(), table.t0, table.ts, commanded, shaped, deviation.distance);
+  io::write_shaped_csv(out->stream(), {table.t0, table.ts, commanded.axes, commanded.positions, shaped, deviation.distance});
   out->commit();
 
   // The summary goes to stdout unless the CSV does.

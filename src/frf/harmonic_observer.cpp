@@ -7,6 +7,27 @@
 #include "servotwin/core/error.hpp"
 
 namespace servotwin::frf {
+namespace {
+
+// x = D^-1 r for the block-diagonal part D of (I - gamma A_cl): one rotation block
+// [[1, -i gamma], [i gamma, 1]] per harmonic and 1 for the DC state. Returns C_o x (the sum of the
+// sine states and the DC state), which the Sherman–Morrison correction needs.
+inline double solve_block_diagonal(const ObserverVector& r, double gamma, ObserverVector& x) noexcept {
+  double c_x = 0.0;
+  for (int i = 1; i <= kHarmonicCount; ++i) {
+    const double a = i * gamma;
+    const double inv = 1.0 / (1.0 + a * a);
+    const double s = r(2 * i - 2), c = r(2 * i - 1);
+    // [[1, -a], [a, 1]]^-1 = [[1, a], [-a, 1]] / (1 + a^2)
+    x(2 * i - 2) = (s + a * c) * inv;
+    x(2 * i - 1) = (c - a * s) * inv;
+    c_x += x(2 * i - 2);
+  }
+  x(kDcState) = r(kDcState);
+  return c_x + x(kDcState);
+}
+
+}  // namespace
 
 TustinRealization tustin_realization(const ObserverVector& k1, double omega, double ts) {
   const double t_prime = 2.0 * std::tan(omega * ts / 2.0) / omega;
@@ -46,33 +67,12 @@ void HarmonicObserver::set_frequency(double omega) noexcept {
   omega_ = omega;
   gamma_ = std::tan(0.5 * omega * ts_);
   // D^-1 k1 and the Sherman–Morrison denominator 1 + gamma C_o D^-1 k1 for this gamma.
-  double c_dinv_k = 0.0;
-  for (int i = 1; i <= kHarmonicCount; ++i) {
-    const double a = i * gamma_;
-    const double inv = 1.0 / (1.0 + a * a);
-    const double s = k1_(2 * i - 2), c = k1_(2 * i - 1);
-    // [[1, -a], [a, 1]]^-1 = [[1, a], [-a, 1]] / (1 + a^2)
-    dinv_k_(2 * i - 2) = (s + a * c) * inv;
-    dinv_k_(2 * i - 1) = (c - a * s) * inv;
-    c_dinv_k += dinv_k_(2 * i - 2);
-  }
-  dinv_k_(kDcState) = k1_(kDcState);
-  c_dinv_k += dinv_k_(kDcState);
+  const double c_dinv_k = solve_block_diagonal(k1_, gamma_, dinv_k_);
   sm_denominator_ = 1.0 + gamma_ * c_dinv_k;
 }
 
 void HarmonicObserver::solve_shifted(const ObserverVector& r, ObserverVector& x) const noexcept {
-  double c_dinv_r = 0.0;
-  for (int i = 1; i <= kHarmonicCount; ++i) {
-    const double a = i * gamma_;
-    const double inv = 1.0 / (1.0 + a * a);
-    const double s = r(2 * i - 2), c = r(2 * i - 1);
-    x(2 * i - 2) = (s + a * c) * inv;
-    x(2 * i - 1) = (c - a * s) * inv;
-    c_dinv_r += x(2 * i - 2);
-  }
-  x(kDcState) = r(kDcState);
-  c_dinv_r += x(kDcState);
+  const double c_dinv_r = solve_block_diagonal(r, gamma_, x);
   x -= dinv_k_ * (gamma_ * c_dinv_r / sm_denominator_);
 }
 
