@@ -3,6 +3,9 @@
 #include <Eigen/Dense>
 #include <unsupported/Eigen/AutoDiff>
 #include <array>
+#include <memory>
+#include <mutex>
+#include <utility>
 #include <cmath>
 #include <numbers>
 
@@ -155,7 +158,7 @@ struct EiProblem {
   bool newton(Vector& x) const {
     Vector f;
     Matrix jacobian;
-    for (int iteration = 0; iteration < 50; ++iteration) {
+    for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
       value_and_jacobian(x, f, jacobian);
       double norm = f.template lpNorm<Eigen::Infinity>();
       if (norm < kTolerance) return true;
@@ -164,7 +167,7 @@ struct EiProblem {
       if (!step.allFinite()) return false;
       double scale = 1.0;
       bool accepted = false;
-      for (int halving = 0; halving < 30 && !accepted; ++halving, scale *= 0.5) {
+      for (int halving = 0; halving < kMaxHalvings && !accepted; ++halving, scale *= 0.5) {
         const Vector trial = x + scale * step;
         if (!in_domain(trial)) continue;
         const double trial_norm = value(trial).template lpNorm<Eigen::Infinity>();
@@ -182,22 +185,26 @@ struct EiProblem {
   }
 
   static constexpr double kTolerance = 1e-13;
+  // Started from a predicted point Newton converges in a few iterations or not at all (the
+  // continuation then halves its step): more iterations would only make failures slow.
+  static constexpr int kMaxIterations = 15;
+  static constexpr int kMaxHalvings = 20;
   static constexpr double kChordContraction = 0.25;
 
   void chord_steps(const Eigen::PartialPivLU<Matrix>& lu, Vector& x, double& norm, int max_steps = 6) const {
+    Vector f = value(x);
     for (int chord = 0; chord < max_steps && norm >= kTolerance; ++chord) {
-      const Vector trial = x + lu.solve(-value(x));
+      const Vector trial = x + lu.solve(-f);
       if (!in_domain(trial)) return;
-      const double trial_norm = value(trial).template lpNorm<Eigen::Infinity>();
-      if (!(trial_norm < kChordContraction * norm)) {
-        if (trial_norm < norm) {
-          x = trial;
-          norm = trial_norm;
-        }
-        return;
+      const Vector trial_f = value(trial);
+      const double trial_norm = trial_f.template lpNorm<Eigen::Infinity>();
+      const bool fast = trial_norm < kChordContraction * norm;
+      if (trial_norm < norm) {
+        x = trial;
+        f = trial_f;
+        norm = trial_norm;
       }
-      x = trial;
-      norm = trial_norm;
+      if (!fast) return;
     }
   }
 };
@@ -230,23 +237,21 @@ Tangent<Impulses, Frequencies> solution_tangent(EiProblem<Impulses, Frequencies>
   return tangent;
 }
 
-// Solves from the undamped closed form `start` (exact at ζ = 0) by continuation in ζ with a
-// tangent predictor: one step for the usual dampings (Newton then needs 2–4 iterations instead
-// of a dozen from the undamped solution), halved whenever Newton does not converge from the
+// Continues a solution `x` of the conditions at damping `reached` to damping `zeta` with a tangent
+// predictor: one step for the usual dampings, halved whenever Newton does not converge from the
 // prediction so that every start stays inside the basin of the solution being followed.
 template <int Impulses, int Frequencies>
-Shaper solve_ei_family(const char* type, const char* label, double omega, double zeta, double v_tol,
-                       const std::array<Condition, EiProblem<Impulses, Frequencies>::kConditions>& conditions,
-                       typename EiProblem<Impulses, Frequencies>::Vector start) {
+typename EiProblem<Impulses, Frequencies>::Vector continue_in_zeta(EiProblem<Impulses, Frequencies> problem,
+                                                                    typename EiProblem<Impulses, Frequencies>::Vector x,
+                                                                    double reached, double zeta, const char* label,
+                                                                    double min_step = 1e-4) {
   using Problem = EiProblem<Impulses, Frequencies>;
-  Problem problem{conditions, 0.0, v_tol};
-  double reached = 0.0;
-  double step = std::min(zeta, 0.1);
+  double step = std::min(zeta - reached, 0.1);
   while (reached < zeta) {
     const double target = std::min(zeta, reached + step);
     problem.zeta = reached;
-    const Tangent<Impulses, Frequencies> tangent = solution_tangent(problem, start);
-    typename Problem::Vector trial = start + (target - reached) * tangent.direction;
+    const Tangent<Impulses, Frequencies> tangent = solution_tangent(problem, x);
+    typename Problem::Vector trial = x + (target - reached) * tangent.direction;
     problem.zeta = target;
     bool converged = false;
     if (Problem::in_domain(trial) && trial.allFinite()) {
@@ -255,15 +260,97 @@ Shaper solve_ei_family(const char* type, const char* label, double omega, double
       converged = norm < Problem::kTolerance || problem.newton(trial);
     }
     if (converged) {
-      start = trial;
+      x = trial;
       reached = target;
       continue;
     }
     step *= 0.5;
-    if (step < 1e-4)
+    if (step < min_step)
       throw core::InputError(core::at_field("zeta"), std::string("no ") + label + " shaper satisfies its defining conditions at zeta = " +
                                                          detail::show(target) + " (design zeta " + detail::show(zeta) + ")");
   }
+  return x;
+}
+
+// Exact solutions of one family at dampings k·kSpacing (from ζ = 0 until the continuation fails, an
+// impulse turns non-positive, or kMaxZeta), with the tangent dx/dζ and the Jacobian's LU factors at each: a design at any damping
+// in range starts from the cubic Hermite interpolation of the two neighbouring nodes (error ~1e-7)
+// and converges with a few chord steps on the nearest node's factors — no new Jacobian.
+template <int Impulses, int Frequencies>
+struct SolutionTable {
+  using Problem = EiProblem<Impulses, Frequencies>;
+  static constexpr double kSpacing = 0.01;
+  static constexpr double kMaxZeta = 0.6;
+  std::vector<Tangent<Impulses, Frequencies>> tangents;
+  std::vector<typename Problem::Vector> solutions;
+
+  SolutionTable(Problem problem, typename Problem::Vector undamped, const char* label) {
+    typename Problem::Vector x = undamped;
+    for (int k = 0;; ++k) {
+      problem.zeta = k * kSpacing;
+      solutions.push_back(x);
+      tangents.push_back(solution_tangent(problem, x));
+      // Past the first node with a non-positive impulse the family has no shaper (the design
+      // refuses it), so the table ends there.
+      if ((k + 1) * kSpacing > kMaxZeta || x.head(Impulses).minCoeff() <= 0.0) break;
+      try {
+        // A coarse minimum step: where the family ends, giving up early costs nothing (designs
+        // beyond the table continue from its last node with the fine default).
+        x = continue_in_zeta(problem, x, k * kSpacing, (k + 1) * kSpacing, label, kSpacing / 8);
+      } catch (const core::InputError&) {
+        break;  // the family ends here; designs beyond it report the failure themselves
+      }
+    }
+  }
+
+  // The solution at `zeta`, or false when zeta lies beyond the table or the corrector fails.
+  bool solve(Problem problem, double zeta, typename Problem::Vector& x) const {
+    const auto k = static_cast<std::size_t>(zeta / kSpacing);
+    if (k + 1 >= solutions.size()) return false;
+    const double u = zeta / kSpacing - static_cast<double>(k);
+    const double u2 = u * u, u3 = u2 * u;
+    x = (2 * u3 - 3 * u2 + 1) * solutions[k] + (u3 - 2 * u2 + u) * kSpacing * tangents[k].direction +
+        (-2 * u3 + 3 * u2) * solutions[k + 1] + (u3 - u2) * kSpacing * tangents[k + 1].direction;
+    problem.zeta = zeta;
+    if (!Problem::in_domain(x)) return false;
+    double norm = problem.value(x).template lpNorm<Eigen::Infinity>();
+    problem.chord_steps(tangents[u < 0.5 ? k : k + 1].lu, x, norm, 20);
+    return norm < Problem::kTolerance || problem.newton(x);
+  }
+
+  // Continuation from the last node, for dampings beyond the table.
+  [[nodiscard]] typename Problem::Vector beyond(Problem problem, double zeta, const char* label) const {
+    return continue_in_zeta(problem, solutions.back(), static_cast<double>(solutions.size() - 1) * kSpacing, zeta, label);
+  }
+};
+
+// The table of a family for a vibration tolerance, built on first use (~0.1–0.5 ms) and shared:
+// the few tolerances a program uses each keep their table.
+template <int Impulses, int Frequencies>
+std::shared_ptr<const SolutionTable<Impulses, Frequencies>> solution_table(
+    const EiProblem<Impulses, Frequencies>& problem, const typename EiProblem<Impulses, Frequencies>::Vector& undamped,
+    const char* label) {
+  static std::mutex mutex;
+  static std::vector<std::pair<double, std::shared_ptr<const SolutionTable<Impulses, Frequencies>>>> tables;
+  const std::lock_guard<std::mutex> lock(mutex);
+  for (const auto& [v_tol, table] : tables)
+    if (v_tol == problem.v_tol) return table;
+  if (tables.size() >= 16) tables.erase(tables.begin());  // bounded: oldest tolerance goes
+  tables.emplace_back(problem.v_tol, std::make_shared<const SolutionTable<Impulses, Frequencies>>(problem, undamped, label));
+  return tables.back().second;
+}
+
+// Solves the family's conditions at `zeta` from the undamped closed form `start` (exact at ζ = 0).
+template <int Impulses, int Frequencies>
+Shaper solve_ei_family(const char* type, const char* label, double omega, double zeta, double v_tol,
+                       const std::array<Condition, EiProblem<Impulses, Frequencies>::kConditions>& conditions,
+                       typename EiProblem<Impulses, Frequencies>::Vector start) {
+  using Problem = EiProblem<Impulses, Frequencies>;
+  const Problem problem{conditions, 0.0, v_tol};
+  const auto table = solution_table(problem, start, label);
+  typename Problem::Vector x;
+  if (!table->solve(problem, zeta, x)) x = table->beyond(problem, zeta, label);
+  start = x;
   std::vector<double> times{0.0};
   std::vector<double> amplitudes;
   for (int i = 0; i < Impulses; ++i) {

@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <thread>
+#include <vector>
 
 #include "fixture.hpp"
 #include "servotwin/core/error.hpp"
@@ -140,6 +142,43 @@ TEST(Families, BadInputNamesTheValue) {
   } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("zeta"), std::string::npos);
   }
+}
+
+// The EI family shares a table of exact solutions per vibration tolerance (built on first use):
+// designs from several threads at once, each first to ask for its tolerance or not, must equal the
+// same designs made one after another (reference: the serial results, themselves checked against
+// ei_family.json above).
+TEST(Families, EiFamilyDesignsAreThreadSafe) {
+  const std::vector<double> zetas = {0.0, 0.013, 0.05, 0.117, 0.15};
+  const std::vector<double> tolerances = {0.011, 0.023, 0.05};
+  auto design_all = [&] {
+    std::vector<Shaper> out;
+    for (double v_tol : tolerances)
+      for (double zeta : zetas)
+        for (ShaperType type : {ShaperType::kEi, ShaperType::kTwoHumpEi, ShaperType::kThreeHumpEi})
+          out.push_back(design_shaper(type, 100.0, zeta, v_tol));
+    return out;
+  };
+  std::vector<std::vector<Shaper>> results(4);
+  std::vector<std::thread> threads;
+  for (auto& r : results) threads.emplace_back([&r, &design_all] { r = design_all(); });
+  for (auto& t : threads) t.join();
+  const std::vector<Shaper> serial = design_all();
+  for (const auto& r : results) {
+    ASSERT_EQ(r.size(), serial.size());
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      expect_near_all(r[i].times, serial[i].times, 1e-15);
+      expect_near_all(r[i].amplitudes, serial[i].amplitudes, 1e-15);
+    }
+  }
+}
+
+// Dampings just beyond the last tabulated node of a family and far beyond it: the same answer as
+// before the table existed (a shaper, or the error naming zeta), never a hang.
+TEST(Families, EiFamilyBeyondItsRange) {
+  EXPECT_THROW((void)three_hump_ei_shaper(100.0, 0.9), core::InputError);
+  EXPECT_THROW((void)two_hump_ei_shaper(100.0, 0.95), core::InputError);
+  EXPECT_THROW((void)ei_shaper(100.0, 0.97), core::InputError);
 }
 
 }  // namespace
