@@ -209,10 +209,8 @@ void clean_and_check(const LpProblem& lp, std::vector<double>& x, double max_pul
 // ------------------------------------------------------------------------------------ checks
 
 void check_omega_zeta(double omega, double zeta, const std::string& where) {
-  if (!std::isfinite(omega) || omega <= 0.0)
-    throw core::InputError(core::at_field(where + ".omega"), "expected a finite frequency > 0 rad/s, got " + show(omega));
-  if (!std::isfinite(zeta) || zeta < 0.0 || zeta >= 1.0)
-    throw core::InputError(core::at_field(where + ".zeta"), "expected a damping ratio in [0, 1), got " + show(zeta));
+  detail::check_frequency(omega, where + ".omega");
+  detail::check_damping(zeta, where + ".zeta");
 }
 
 /// Everything except the grid (pulse_spacing, pulse_count).

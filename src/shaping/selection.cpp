@@ -12,6 +12,7 @@
 #include "servotwin/shaping/multimode.hpp"
 #include "servotwin/shaping/sensitivity.hpp"
 #include "servotwin/shaping/smoothing.hpp"
+#include "shaper_checks.hpp"
 
 namespace servotwin::shaping {
 
@@ -385,8 +386,7 @@ void check_options(const SpectrumSelectionOptions& o) {
   require(!o.families.empty(), "families", "expected at least one shaper family");
   for (ShaperType t : o.families)
     require(t != ShaperType::kZv4, "families", "zv4 needs its p-parameters and cannot be auto-tuned here");
-  require(std::isfinite(o.design_zeta) && o.design_zeta >= 0.0 && o.design_zeta < 1.0, "design_zeta",
-          fmt::format("expected a damping ratio in [0, 1), got {}", o.design_zeta));
+  detail::check_damping(o.design_zeta, "design_zeta");
   check_measure(o.measure);
   check_positive(o.min_shaper_freq_hz, "min_shaper_freq_hz");
   check_positive(o.freq_step_hz, "freq_step_hz");
@@ -607,8 +607,7 @@ ShaperSelection select_shaper_from_model(const std::vector<KnownMode>& modes, co
   require(!modes.empty(), "modes", "expected at least one resonance mode");
   for (std::size_t i = 0; i < modes.size(); ++i) {
     check_positive(modes[i].freq_hz, fmt::format("modes[{}].freq_hz", i));
-    require(std::isfinite(modes[i].zeta) && modes[i].zeta >= 0.0 && modes[i].zeta < 1.0,
-            fmt::format("modes[{}].zeta", i), fmt::format("expected a damping ratio in [0, 1), got {}", modes[i].zeta));
+    detail::check_damping(modes[i].zeta, fmt::format("modes[{}].zeta", i));
   }
   require(!o.families.empty(), "families", "expected at least one shaper family");
   require(std::isfinite(o.freq_uncertainty) && o.freq_uncertainty >= 0.0 && o.freq_uncertainty < 0.5,
@@ -620,8 +619,7 @@ ShaperSelection select_shaper_from_model(const std::vector<KnownMode>& modes, co
   if (o.max_delay_s) check_positive(*o.max_delay_s, "max_delay_s");
   check_positive(o.accel, "accel");
   check_positive(o.max_accel_smoothing, "max_accel_smoothing");
-  require(std::isfinite(o.assumed_zeta) && o.assumed_zeta >= 0.0 && o.assumed_zeta < 1.0, "assumed_zeta",
-          fmt::format("expected a damping ratio in [0, 1), got {}", o.assumed_zeta));
+  detail::check_damping(o.assumed_zeta, "assumed_zeta");
 
   // Worst residual over every mode, its frequency band and its damping range.
   auto worst_residual = [&](const Shaper& sh) {

@@ -15,8 +15,7 @@ void check_mode(double omega, double zeta, const char* omega_name, const char* z
   if (!std::isfinite(omega) || omega < 0.0)
     throw core::InputError(core::at_field(omega_name),
                            "expected a finite frequency >= 0 rad/s, got " + detail::show(omega));
-  if (!std::isfinite(zeta) || zeta < 0.0 || zeta >= 1.0)
-    throw core::InputError(core::at_field(zeta_name), "expected a damping ratio in [0, 1), got " + detail::show(zeta));
+  detail::check_damping(zeta, zeta_name);
 }
 
 void check_shaper(const Shaper& shaper) {

@@ -6,7 +6,13 @@
 
 namespace servotwin::shaping::detail {
 
-/// Throws core::InputError naming "omega" (finite, > 0) or "zeta" ([0, 1)).
+/// Throws core::InputError naming `field` unless omega is a finite frequency > 0 [rad/s].
+void check_frequency(double omega, const std::string& field);
+
+/// Throws core::InputError naming `field` unless zeta is a damping ratio in [0, 1).
+void check_damping(double zeta, const std::string& field);
+
+/// check_frequency(omega, "omega") and check_damping(zeta, "zeta").
 void check_design_mode(double omega, double zeta);
 
 /// A number as printed in error messages (%.10g).
