@@ -56,13 +56,8 @@ void check_mode(const DesignArgs& a) {
   if (!std::isfinite(a.zeta) || a.zeta < 0.0 || a.zeta >= 1.0)
     throw core::InputError(core::at_field("--zeta"), fmt::format("expected a damping ratio in [0, 1), got {}", a.zeta));
   if (a.ts_option->count() > 0) {
-    if (!std::isfinite(a.ts) || a.ts <= 0.0)
-      throw core::InputError(core::at_field("--ts"), fmt::format("expected a sample period > 0 s, got {}", a.ts));
-    const double nyquist_hz = 0.5 / a.ts;
-    if (a.freq_hz >= nyquist_hz)
-      throw core::InputError(core::at_field("--freq-hz"),
-                             fmt::format("{} Hz is at or beyond the Nyquist frequency {} Hz of --ts {} s", a.freq_hz,
-                                         nyquist_hz, a.ts));
+    check_sample_period(a.ts);
+    check_below_nyquist(a.freq_hz, a.ts, "--freq-hz");
   }
 }
 

@@ -1,11 +1,24 @@
 #include "command.hpp"
 
 #include <cctype>
+#include <cmath>
 
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/program_file.hpp"
 
 namespace servotwin::cli {
+
+void check_sample_period(double ts, const std::string& option) {
+  if (!std::isfinite(ts) || ts <= 0.0)
+    throw core::InputError(core::at_field(option), fmt::format("expected a sample period > 0 s, got {}", ts));
+}
+
+void check_below_nyquist(double freq_hz, double ts, const std::string& option) {
+  const double nyquist_hz = 0.5 / ts;
+  if (freq_hz >= nyquist_hz)
+    throw core::InputError(core::at_field(option), fmt::format("{} Hz is at or beyond the Nyquist frequency {} Hz of --ts {} s",
+                                                               freq_hz, nyquist_hz, ts));
+}
 
 std::unique_ptr<io::OutputFile> open_output(const std::string& path, const GlobalOptions& global) {
   return std::make_unique<io::OutputFile>(path, global.force ? io::Overwrite::Allow : io::Overwrite::Refuse);

@@ -55,6 +55,13 @@ void progress(const GlobalOptions& global, fmt::format_string<Args...> format, A
 /// Opens an output file honouring --force; "-" writes to stdout.
 std::unique_ptr<io::OutputFile> open_output(const std::string& path, const GlobalOptions& global);
 
+/// Throws core::InputError naming `option` unless ts is a finite sample period > 0 s.
+void check_sample_period(double ts, const std::string& option = "--ts");
+
+/// Throws core::InputError naming `option` when freq_hz is at or beyond the Nyquist frequency of
+/// the sample period ts (a shaper or controller for that mode cannot run at ts).
+void check_below_nyquist(double freq_hz, double ts, const std::string& option);
+
 /// Parses axis lists such as "X", "xy", "X,Y" (repeatable option values) into axes.
 std::vector<motion::Axis> parse_axes(const std::vector<std::string>& values, const std::string& option);
 

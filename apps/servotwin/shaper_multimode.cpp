@@ -84,9 +84,7 @@ std::vector<ModeHz> parse_modes(const MultimodeArgs& a) {
       throw core::InputError(core::at_field("--mode-hz"), fmt::format("expected a frequency > 0 Hz in '{}'", value));
     if (z < 0.0 || z >= 1.0)
       throw core::InputError(core::at_field("--mode-hz"), fmt::format("expected a damping ratio in [0, 1) in '{}'", value));
-    if (a.has("--ts") && a.ts > 0.0 && f >= 0.5 / a.ts)
-      throw core::InputError(core::at_field("--mode-hz"),
-                             fmt::format("{} Hz is at or beyond the Nyquist frequency {} Hz of --ts {} s", f, 0.5 / a.ts, a.ts));
+    if (a.has("--ts")) check_below_nyquist(f, a.ts, "--mode-hz");
     modes.push_back({f, z});
   }
   return modes;
@@ -109,8 +107,7 @@ std::vector<BoundRatio> parse_bounds(const MultimodeArgs& a) {
 void check_option_use(const MultimodeArgs& a) {
   if (a.method != "lp" && a.method != "convolve")
     throw core::InputError(core::at_field("--method"), "expected lp or convolve, got '" + a.method + "'");
-  if (a.has("--ts") && (!std::isfinite(a.ts) || a.ts <= 0.0))
-    throw core::InputError(core::at_field("--ts"), fmt::format("expected a sample period > 0 s, got {}", a.ts));
+  if (a.has("--ts")) check_sample_period(a.ts);
   if (a.method == "convolve") {
     for (const char* option : {"--derivatives", "--bound", "--tp", "--n", "--cost-k"})
       if (a.has(option)) throw core::InputError(core::at_field(option), "applies only to --method lp");

@@ -287,13 +287,8 @@ std::vector<ShaperComparison> shaper_comparison(const std::vector<NamedShaper>& 
     c.row = rows[i];
     c.freq_hz = shapers[i].shaper.omega / kTwoPi;
     c.zeta = shapers[i].shaper.zeta;
-    try {
-      c.max_accel = shaping::max_accel_for_smoothing(shapers[i].shaper, options.max_smoothing, options.comparison.scv);
-    } catch (const core::InputError&) {
-      // The limit is below the smoothing the shaper has at the square-corner velocity alone: the
-      // options were checked above, so no acceleration meets it.
-      c.max_accel = std::numeric_limits<double>::quiet_NaN();
-    }
+    c.max_accel = shaping::reachable_max_accel(shapers[i].shaper, options.max_smoothing, options.comparison.scv)
+                      .value_or(std::numeric_limits<double>::quiet_NaN());
     out.push_back(std::move(c));
   }
   return out;

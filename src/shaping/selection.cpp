@@ -36,11 +36,9 @@ SpectrumAxis parse_spectrum_axis(const std::string& name, const std::string& fie
 
 namespace {
 
-// Klipper's suggested max_accel; 0 when even at zero acceleration the corner at scv smooths more
-// than the target (long shapers for slow modes: no acceleration meets it).
+// Klipper's suggested max_accel; 0 when no acceleration meets the target.
 double suggested_max_accel(const Shaper& shaper, double max_smoothing, double scv) {
-  if (shaper_smoothing(shaper, 0.0, scv) > max_smoothing) return 0.0;
-  return max_accel_for_smoothing(shaper, max_smoothing, scv);
+  return reachable_max_accel(shaper, max_smoothing, scv).value_or(0.0);
 }
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;

@@ -50,15 +50,10 @@ double shaper_smoothing(const Shaper& shaper, double accel, double scv) {
   return smoothing_offsets(shaper, accel, scv).smoothing();
 }
 
-double max_accel_for_smoothing(const Shaper& shaper, double max_smoothing, double scv) {
+std::optional<double> reachable_max_accel(const Shaper& shaper, double max_smoothing, double scv) {
   if (!std::isfinite(max_smoothing) || max_smoothing <= 0.0)
     throw core::InputError(core::at_field("max_smoothing"), "expected a length > 0, got " + detail::show(max_smoothing));
-  const double at_rest = shaper_smoothing(shaper, 0.0, scv);
-  if (at_rest > max_smoothing)
-    throw core::InputError(core::at_field("max_smoothing"),
-                           detail::show(max_smoothing) + " is below the smoothing " + detail::show(at_rest) +
-                               " this shaper has at zero acceleration and scv = " + detail::show(scv) +
-                               "; no acceleration meets it");
+  if (shaper_smoothing(shaper, 0.0, scv) > max_smoothing) return std::nullopt;
   if (shaper.duration() == 0.0) return std::numeric_limits<double>::infinity();  // a single impulse never smooths
   double low = 0.0;
   double high = 1.0;
@@ -71,6 +66,15 @@ double max_accel_for_smoothing(const Shaper& shaper, double max_smoothing, doubl
     (shaper_smoothing(shaper, mid, scv) <= max_smoothing ? low : high) = mid;
   }
   return low;
+}
+
+double max_accel_for_smoothing(const Shaper& shaper, double max_smoothing, double scv) {
+  if (const std::optional<double> accel = reachable_max_accel(shaper, max_smoothing, scv)) return *accel;
+  throw core::InputError(core::at_field("max_smoothing"),
+                         detail::show(max_smoothing) + " is below the smoothing " +
+                             detail::show(shaper_smoothing(shaper, 0.0, scv)) +
+                             " this shaper has at zero acceleration and scv = " + detail::show(scv) +
+                             "; no acceleration meets it");
 }
 
 }  // namespace servotwin::shaping

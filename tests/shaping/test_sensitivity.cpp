@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "fixture.hpp"
@@ -112,6 +113,18 @@ TEST(Smoothing, MaxAccelInvertsTheMeasure) {
   EXPECT_NEAR(shaper_smoothing(mzv, accel, 5.0), 0.12, 1e-9);
   EXPECT_THROW((void)max_accel_for_smoothing(mzv, 1e-6, 5.0), core::InputError);
   EXPECT_THROW((void)smoothing_offsets(mzv, -1.0, 5.0), core::InputError);
+}
+
+// The selection and the comparison report both ask "largest acceleration, or none": one function
+// answers, nullopt exactly where max_accel_for_smoothing refuses.
+TEST(Smoothing, ReachableMaxAccelIsNoneExactlyWhenTheCornerAloneSmoothsMore) {
+  const Shaper mzv = mzv_shaper(2.0 * pi * 50.0, 0.1);
+  EXPECT_EQ(reachable_max_accel(mzv, 0.12, 5.0), max_accel_for_smoothing(mzv, 0.12, 5.0));
+  const double at_rest = shaper_smoothing(mzv, 0.0, 5.0);
+  EXPECT_FALSE(reachable_max_accel(mzv, 0.99 * at_rest, 5.0).has_value());
+  EXPECT_TRUE(reachable_max_accel(mzv, 1.01 * at_rest, 5.0).has_value());
+  EXPECT_EQ(reachable_max_accel(Shaper{"single", 1.0, 0.0, {0.0}, {1.0}}, 0.12, 5.0), std::numeric_limits<double>::infinity());
+  EXPECT_THROW((void)reachable_max_accel(mzv, 0.0, 5.0), core::InputError);
 }
 
 TEST(Compare, RowsCarryEveryMeasure) {

@@ -23,6 +23,8 @@
 /// accel = 5000 mm/s², scv = 5 mm/s). This is the current Klipper definition (both corner legs,
 /// combined by hypot); older Klipper versions took only the X leg times √2.
 
+#include <optional>
+
 #include "servotwin/shaping/shaper.hpp"
 
 namespace servotwin::shaping {
@@ -46,5 +48,10 @@ double shaper_smoothing(const Shaper& shaper, double accel = 5000.0, double scv 
 /// "suggested max_accel", which uses 0.12 mm and scv = 5 mm/s). Smoothing grows monotonically with
 /// accel, so the answer is found by bracketing and bisection (relative accuracy 1e-9).
 double max_accel_for_smoothing(const Shaper& shaper, double max_smoothing = 0.12, double scv = 5.0);
+
+/// max_accel_for_smoothing, or nullopt when no acceleration meets the limit because the corner at
+/// scv alone smooths more than max_smoothing (long shapers for slow modes). Still throws
+/// core::InputError for a max_smoothing that is not a length > 0.
+std::optional<double> reachable_max_accel(const Shaper& shaper, double max_smoothing = 0.12, double scv = 5.0);
 
 }  // namespace servotwin::shaping
