@@ -12,6 +12,7 @@
 #include "bode.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/transfer_function.hpp"
+#include "number_format.hpp"
 
 namespace servotwin::report {
 
@@ -23,10 +24,7 @@ using detail::unwrapped_phase_deg;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr std::size_t kModelPoints = 1200;
 
-std::string num(double v, int digits = 6) {
-  if (!std::isfinite(v)) return "-";
-  return fmt::format("{:.{}g}", v, digits);
-}
+std::string num(double v, int digits = 6) { return detail::format_number(v, digits); }
 
 /// "value ± std" with the std omitted when it is not identifiable.
 std::string with_std(double value, double std_dev, double scale = 1.0) {

@@ -17,6 +17,7 @@
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/transfer_function.hpp"
 #include "servotwin/rapid/axis_model.hpp"
+#include "number_format.hpp"
 
 namespace servotwin::report {
 
@@ -28,10 +29,7 @@ using detail::unwrapped_phase_deg;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr std::size_t kFrequencyPoints = 800;
 
-std::string num(double v, int significant = 5) {
-  if (!std::isfinite(v)) return std::isnan(v) ? "not finite" : (v > 0 ? "+inf" : "-inf");
-  return fmt::format("{:.{}g}", v, significant);
-}
+std::string num(double v, int significant = 5) { return detail::format_number(v, significant); }
 
 std::string fixed(double v, int decimals) {
   if (!std::isfinite(v)) return num(v);

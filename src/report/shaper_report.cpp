@@ -11,6 +11,7 @@
 
 #include "servotwin/core/error.hpp"
 #include "servotwin/shaping/smoothing.hpp"
+#include "number_format.hpp"
 
 namespace servotwin::report {
 
@@ -23,10 +24,7 @@ constexpr std::size_t kDampingPoints = 401;
 /// design-frequency lobe of the longer shapers, where their robustness differs most).
 constexpr double kDefaultFreqSpan = 2.5;
 
-std::string num(double v, int digits = 4) {
-  if (!std::isfinite(v)) return "-";
-  return fmt::format("{:.{}g}", v, digits);
-}
+std::string num(double v, int digits = 4) { return detail::format_number(v, digits); }
 
 std::string shaper_where(std::size_t i) { return "shapers[" + std::to_string(i) + "]"; }
 
