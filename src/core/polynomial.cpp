@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -22,10 +23,12 @@ std::vector<double> strip_leading_zeros(std::vector<double> c) {
   return c;
 }
 
-void require_finite(std::span<const double> c) {
+void require_finite_for(std::span<const double> c, const char* message) {
   for (double v : c)
-    if (!std::isfinite(v)) throw std::invalid_argument("Polynomial::roots: coefficients must be finite");
+    if (!std::isfinite(v)) throw std::invalid_argument(message);
 }
+
+void require_finite(std::span<const double> c) { require_finite_for(c, "Polynomial::roots: coefficients must be finite"); }
 
 /// Value and derivative of p at z, with magnitude = sum |c_i| |z|^(n-i), the scale of the
 /// rounding errors of the Horner recurrence: |fl(p(z)) - p(z)| <= gamma_{2n} * magnitude (Higham,
@@ -349,6 +352,73 @@ Polynomial operator*(double k, const Polynomial& a) {
   std::vector<double> out(a.coefficients().begin(), a.coefficients().end());
   for (double& v : out) v *= k;
   return Polynomial(std::move(out));
+}
+
+namespace {
+
+/// Row width of the Routh array of a degree-n polynomial (the first row c0, c2, ..., padded).
+constexpr std::size_t kRouthStackWidth = 32;  // degree <= 63 on the stack
+
+/// Rescales a Routh row by a power of two when its largest entry leaves [2^-100, 2^100]: a positive
+/// factor on one row scales every later row that depends on it by a positive factor (the ratio
+/// r_{i-2}[0] / r_{i-1}[0] absorbs the other), so no first-column sign changes.
+void keep_row_in_range(std::span<double> row) noexcept {
+  double largest = 0.0;
+  for (double v : row) largest = std::max(largest, std::abs(v));
+  constexpr double upper = 0x1p100, lower = 0x1p-100;
+  if ((largest <= upper && largest >= lower) || largest == 0.0 || !std::isfinite(largest)) return;
+  const double factor = std::ldexp(1.0, -std::ilogb(largest));
+  for (double& v : row) v *= factor;
+}
+
+/// Routh test on the sign-normalised first two rows `older`, `newer` (width w, zero padded);
+/// `next` is scratch of width w.
+bool routh_first_column_positive(std::span<double> older, std::span<double> newer, std::span<double> next,
+                                 int degree) noexcept {
+  const std::size_t w = older.size();
+  keep_row_in_range(older);
+  keep_row_in_range(newer);
+  for (int row = 2; row <= degree; ++row) {
+    const double ratio = older[0] / newer[0];
+    for (std::size_t j = 0; j + 1 < w; ++j) next[j] = older[j + 1] - ratio * newer[j + 1];
+    next[w - 1] = 0.0;
+    // A zero or negative first-column entry (NaN included) ends the test: not Hurwitz.
+    if (!(next[0] > 0.0)) return false;
+    keep_row_in_range(next);
+    std::swap(older, newer);
+    std::swap(newer, next);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool is_hurwitz(const Polynomial& p) {
+  const std::span<const double> c = p.coefficients();
+  if (c.empty()) throw std::invalid_argument("is_hurwitz: the zero polynomial has no Hurwitz property");
+  require_finite_for(c, "is_hurwitz: coefficients must be finite");
+  const int degree = p.degree();
+  if (degree == 0) return true;
+  // Every coefficient of a Hurwitz polynomial has the leading coefficient's sign (a product of
+  // positive linear and quadratic factors); this necessary condition also settles rows 0 and 1.
+  const double sign = c[0] > 0.0 ? 1.0 : -1.0;
+  for (double v : c)
+    if (!(sign * v > 0.0)) return false;
+  if (degree <= 2) return true;  // positive coefficients suffice up to degree 2
+  const std::size_t w = static_cast<std::size_t>(degree) / 2 + 1;
+  std::array<double, 3 * kRouthStackWidth> stack;  // not zeroed: every used entry is written below
+  std::vector<double> heap;
+  double* storage = stack.data();
+  if (w > kRouthStackWidth) {
+    heap.assign(3 * w, 0.0);
+    storage = heap.data();
+  }
+  const std::span<double> row0(storage, w), row1(storage + w, w), scratch(storage + 2 * w, w);
+  for (std::size_t j = 0; j < w; ++j) {
+    row0[j] = 2 * j < c.size() ? sign * c[2 * j] : 0.0;
+    row1[j] = 2 * j + 1 < c.size() ? sign * c[2 * j + 1] : 0.0;
+  }
+  return routh_first_column_positive(row0, row1, scratch, degree);
 }
 
 }  // namespace servotwin::core

@@ -13,7 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "json_fixture.hpp"
 #include "servotwin/core/polynomial.hpp"
+#include "servotwin/core/state_space.hpp"
 
 namespace servotwin::core {
 /// Readable GoogleTest failure messages: coefficients highest power first.
@@ -27,12 +29,15 @@ inline void PrintTo(const Polynomial& p, std::ostream* os) {
 namespace servotwin::core::test {
 
 inline const nlohmann::json& core_reference() {
-  static const nlohmann::json data = [] {
-    const std::string path = std::string(SERVOTWIN_TEST_DATA_DIR) + "/core/core_reference.json";
-    std::ifstream in(path);
-    if (!in) throw std::runtime_error("cannot open " + path + " (run tools/reference/core_reference.py)");
-    return nlohmann::json::parse(in);
-  }();
+  static const nlohmann::json data = test_support::read_json_fixture("core/core_reference.json", "core_reference.py");
+  return data;
+}
+
+/// tests/data/core/control_reference.json, written by tools/reference/core_control_reference.py
+/// (state-space algebra, Tustin, H-infinity norms).
+inline const nlohmann::json& control_reference() {
+  static const nlohmann::json data =
+      test_support::read_json_fixture("core/control_reference.json", "core_control_reference.py");
   return data;
 }
 
@@ -54,6 +59,18 @@ inline Eigen::MatrixXd to_matrix(const nlohmann::json& rows) {
   for (Eigen::Index i = 0; i < r; ++i)
     for (Eigen::Index j = 0; j < c; ++j) m(i, j) = rows[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)].get<double>();
   return m;
+}
+
+/// A StateSpace from a fixture object with members A, B, C, D.
+inline StateSpace system_from(const nlohmann::json& s) {
+  return StateSpace{to_matrix(s.at("A")), to_matrix(s.at("B")), to_matrix(s.at("C")), to_matrix(s.at("D"))};
+}
+
+/// The system called `name` in control_reference()["systems"].
+inline StateSpace reference_system(const std::string& name) {
+  for (const auto& s : control_reference().at("systems"))
+    if (s.at("name") == name) return system_from(s);
+  throw std::runtime_error("no system " + name + " in control_reference.json");
 }
 
 inline Eigen::VectorXd to_vector(const nlohmann::json& values) {

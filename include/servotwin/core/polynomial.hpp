@@ -72,4 +72,26 @@ class Polynomial {
   std::vector<double> c_;
 };
 
+/// Hurwitz test by the Routh array: true when every root of p lies strictly in the open left half
+/// plane (Re < 0).
+///
+/// Method: the leading coefficient's sign is normalised to +; a zero or negative coefficient
+/// already rules out Hurwitz (necessary condition); otherwise the Routh array is built from the
+/// coefficients (rows [c0 c2 c4 ...], [c1 c3 c5 ...], then r_i[j] = r_{i-2}[j+1] -
+/// (r_{i-2}[0] / r_{i-1}[0]) r_{i-1}[j+1]) and p is Hurwitz iff all n+1 first-column entries are
+/// > 0. Rule for the degenerate cases: a zero in the first column (including an all-zero row)
+/// means a root on or to the right of the imaginary axis or a root pair symmetric about the origin;
+/// no epsilon-perturbation or auxiliary-polynomial continuation is attempted and the answer is
+/// "not Hurwitz" (conservative). Every row is rescaled by a power of two when its entries leave
+/// [2^-100, 2^100] (a positive factor on one row changes no first-column sign later in the array),
+/// so coefficients spanning most of the exponent range (e.g. 1e100 s^3 + 1e-250 s^2 + ...) neither
+/// overflow nor underflow. The arithmetic is floating point: a polynomial within rounding
+/// (~ eps * coefficient scale) of one with a root on the imaginary axis may go either way. The tests
+/// decide random root sets of degree <= 12 correctly down to relative margins |Re|/|root| of 1e-9
+/// (a root-based test with any fixed tolerance cannot).
+///
+/// A nonzero constant (degree 0) is Hurwitz (no roots). Throws std::invalid_argument for the zero
+/// polynomial and for non-finite coefficients. Allocation-free up to degree 63.
+[[nodiscard]] bool is_hurwitz(const Polynomial& p);
+
 }  // namespace servotwin::core
