@@ -1,0 +1,116 @@
+// PI/PID design times on a fitted two-mass plant with friction (issue 7, §9 of the issue).
+// Target: a PI/PID design together with its robustness scan <= 10 ms in total, so the design
+// part measured here (normalization, numeric pole placement, second pair, admissible range,
+// advice) should stay well under 1 ms; a single pole placement is on the inner loop of every ω*
+// scan and should take a few microseconds.
+#include <benchmark/benchmark.h>
+
+#include <cstdint>
+
+#include "servotwin/fit/plant_model.hpp"
+#include "servotwin/tuning/normalized_plant.hpp"
+#include "servotwin/tuning/pi_design.hpp"
+#include "servotwin/tuning/robustness.hpp"
+
+namespace {
+
+using namespace servotwin;
+using namespace servotwin::tuning;
+
+/// A belt axis like the catalog's A5 (fz = 4.5 Hz, fn = 12.1 Hz) with friction, a second mode and
+/// a lag, as a fit would return it.
+fit::PlantModel belt_axis() {
+  constexpr double two_pi = 6.283185307179586;
+  fit::PlantModel m;
+  m.gain = 180.0;
+  m.rigid_pole_rad_s = 2.5;
+  m.modes = {{{two_pi * 4.5, 0.03}, {two_pi * 12.1, 0.07}}, {{two_pi * 60.0, 0.02}, {two_pi * 85.0, 0.03}}};
+  m.lag_pole_rad_s = 2500.0;
+  return m;
+}
+
+void BM_PiPolePlacement(benchmark::State& state) {
+  const core::TransferFunction plant = normalize(belt_axis()).motor(false);
+  double omega_star = 0.5;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(pi_pole_placement(plant, omega_star, 0.8));
+    omega_star += 1e-12;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_PiPolePlacement);
+
+void BM_SecondPair(benchmark::State& state) {
+  const NormalizedPlant plant = normalize(belt_axis());
+  const PiGains gains = pi_pole_placement(plant.motor(false), 0.5, 0.8).gains;
+  for (auto _ : state) benchmark::DoNotOptimize(second_pair(plant, gains, 0.5, 0.8));
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_SecondPair);
+
+void BM_AdmissibleRange(benchmark::State& state) {
+  const NormalizedPlant plant = normalize(belt_axis());
+  for (auto _ : state) benchmark::DoNotOptimize(admissible_range(plant, 0.8));
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_AdmissibleRange)->Unit(benchmark::kMicrosecond);
+
+// The whole design step a `tune --structure pi` / `pid` call makes before its robustness scan.
+void BM_PiDesignTotal(benchmark::State& state) {
+  const fit::PlantModel model = belt_axis();
+  for (auto _ : state) {
+    const NormalizedPlant plant = normalize(model);
+    const ResonanceRatioAdvice advice = advise(plant.r, 0.8);
+    const AdmissibleRange range = admissible_range(plant, 0.8);
+    const double omega_star = 0.9 * range.omega_max;
+    const PolePlacement placed = pi_pole_placement(plant.motor(false), omega_star, 0.8);
+    const SecondPair pair = second_pair(plant, placed.gains, omega_star, 0.8);
+    const PidDesign pid = pid_design(plant, 2.0, omega_star, 0.8, default_derivative_time_constant(plant.r, omega_star));
+    benchmark::DoNotOptimize(advice);
+    benchmark::DoNotOptimize(to_physical(placed.gains, plant));
+    benchmark::DoNotOptimize(pair);
+    benchmark::DoNotOptimize(pid);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_PiDesignTotal)->Unit(benchmark::kMicrosecond);
+
+// ---------------------------------------------------------------- robustness (C7.9, plan §1.7)
+// Target: the whole robustness scan (Kharitonov, the 5⁶-point grid fallback, the largest robust
+// ω* search) within the 10 ms PI budget. E28 boxes: "literal" (±10 %, ω ±30 %) makes Kharitonov
+// fail so the grid runs; "w48" (ω ±48 %) makes the ω* search scan and bisect.
+
+IntervalPlant e28_box(double omega_spread) {
+  return make_interval_plant({1.0, 0.1, 0.02, 0.01, 2.0, 1.0}, {0.1, 0.1, 0.1, 0.1, omega_spread, 0.1});
+}
+
+void BM_Kharitonov(benchmark::State& state) {
+  const IntervalPlant box = e28_box(0.3);
+  const PiGains gains = nominal_pi_design(box, 0.9, 0.7071067811865476);
+  for (auto _ : state) benchmark::DoNotOptimize(kharitonov(box, gains));
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Kharitonov);
+
+// Items: grid cases (15625 per call).
+void BM_GridCheck5(benchmark::State& state) {
+  const IntervalPlant box = e28_box(0.3);
+  const PiGains gains = nominal_pi_design(box, 0.9, 0.7071067811865476);
+  std::size_t cases = 0;
+  for (auto _ : state) {
+    const GridResult r = grid_check(box, gains, 5);
+    cases += r.cases;
+    benchmark::DoNotOptimize(r);
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(cases));
+}
+BENCHMARK(BM_GridCheck5)->Unit(benchmark::kMicrosecond);
+
+void BM_LargestRobustOmegaStar(benchmark::State& state) {
+  const IntervalPlant box = e28_box(static_cast<double>(state.range(0)) / 100.0);
+  for (auto _ : state) benchmark::DoNotOptimize(largest_robust_omega_star(box, 0.7071067811865476));
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_LargestRobustOmegaStar)->Arg(30)->Arg(48)->Unit(benchmark::kMillisecond);
+
+}  // namespace

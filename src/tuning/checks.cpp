@@ -1,0 +1,46 @@
+#include "checks.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "servotwin/core/error.hpp"
+
+namespace servotwin::tuning::detail {
+
+std::string show(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.10g", value);
+  return buffer;
+}
+
+std::string show(std::complex<double> root) {
+  if (root.imag() == 0.0) return show(root.real());
+  return show(root.real()) + (root.imag() < 0.0 ? " - " : " + ") + show(std::abs(root.imag())) + "j";
+}
+
+void require_positive(double value, const std::string& field, const std::string& what) {
+  if (!std::isfinite(value) || value <= 0.0)
+    throw core::InputError(core::at_field(field), "expected " + what + " > 0, got " + show(value));
+}
+
+void require_non_negative(double value, const std::string& field, const std::string& what) {
+  if (!std::isfinite(value) || value < 0.0)
+    throw core::InputError(core::at_field(field), "expected " + what + " >= 0, got " + show(value));
+}
+
+void require_finite(double value, const std::string& field) {
+  if (!std::isfinite(value)) throw core::InputError(core::at_field(field), "expected a finite value, got " + show(value));
+}
+
+void require_ratio(double r, const std::string& field) {
+  if (!std::isfinite(r) || r <= 1.0)
+    throw core::InputError(core::at_field(field),
+                           "expected a resonance ratio r = wn/wz > 1 (collocated two-mass plant), got " + show(r));
+}
+
+void require_pair(double omega_star, double zeta_star) {
+  require_positive(omega_star, "omega_star", "a bandwidth");
+  require_positive(zeta_star, "zeta_star", "a damping ratio");
+}
+
+}  // namespace servotwin::tuning::detail

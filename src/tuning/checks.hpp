@@ -1,0 +1,24 @@
+#pragma once
+// Argument checks shared by the tuning sources: each throws core::InputError naming the parameter.
+#include <complex>
+#include <string>
+
+namespace servotwin::tuning::detail {
+
+/// %.10g of a value (messages).
+std::string show(double value);
+/// "a ± bj" of a complex root (messages).
+std::string show(std::complex<double> root);
+
+/// finite and > 0.
+void require_positive(double value, const std::string& field, const std::string& what = "a value");
+/// finite and >= 0.
+void require_non_negative(double value, const std::string& field, const std::string& what = "a value");
+/// finite.
+void require_finite(double value, const std::string& field);
+/// finite and > 1 (a resonance ratio).
+void require_ratio(double r, const std::string& field);
+/// ω* > 0 and ζ* > 0, both finite.
+void require_pair(double omega_star, double zeta_star);
+
+}  // namespace servotwin::tuning::detail

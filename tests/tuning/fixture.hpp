@@ -1,0 +1,63 @@
+#pragma once
+// Test helpers for module tuning: the fixture written by tools/reference/tuning_reference.py and
+// small comparisons.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <vector>
+
+#include "json_fixture.hpp"
+#include "servotwin/core/polynomial.hpp"
+#include "servotwin/core/transfer_function.hpp"
+
+namespace servotwin::tuning::test {
+
+inline constexpr double kSqrtHalf = std::numbers::sqrt2 / 2.0;
+
+/// tests/data/tuning/tuning_reference.json (parsed once).
+inline const nlohmann::json& reference() {
+  static const nlohmann::json j =
+      test_support::read_json_fixture("tuning/tuning_reference.json", "tuning_reference.py");
+  return j;
+}
+
+/// Relative difference with an absolute floor of 1 (for values that may be ~0).
+inline double rel_diff(double a, double b) { return std::abs(a - b) / std::max({std::abs(a), std::abs(b), 1.0}); }
+
+/// A [re, im] pair from the fixture.
+inline std::complex<double> root_of(const nlohmann::json& pair) { return {pair.at(0).get<double>(), pair.at(1).get<double>()}; }
+
+/// Roots sorted by (modulus, real part, imaginary part descending) for pairwise comparison.
+inline std::vector<std::complex<double>> sorted_roots(std::vector<std::complex<double>> v) {
+  std::sort(v.begin(), v.end(), [](std::complex<double> x, std::complex<double> y) {
+    if (std::abs(std::abs(x) - std::abs(y)) > 1e-9 * std::max(std::abs(x), 1.0)) return std::abs(x) < std::abs(y);
+    return x.imag() > y.imag();
+  });
+  return v;
+}
+
+/// Minimum damping -Re/|.| over the roots of a polynomial, and the root where it occurs.
+inline std::pair<double, std::complex<double>> min_damping(const core::Polynomial& c) {
+  double best = 2.0;
+  std::complex<double> at;
+  for (const std::complex<double>& x : c.roots()) {
+    const double z = -x.real() / std::abs(x);
+    if (z < best) {
+      best = z;
+      at = x;
+    }
+  }
+  return {best, at};
+}
+
+/// The normalized frictionless two-mass TF (1/s)(s² + 2ζz s + 1)/(s² + 2ζz r² s + r²) written out
+/// here (catalog §0), independently of NormalizedPlant::motor().
+inline core::TransferFunction frictionless_tf(double r, double zeta_z) {
+  return {core::Polynomial{1.0, 2.0 * zeta_z, 1.0},
+          core::Polynomial{1.0, 0.0} * core::Polynomial{1.0, 2.0 * zeta_z * r * r, r * r}};
+}
+
+}  // namespace servotwin::tuning::test
