@@ -6,10 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <functional>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "json_fixture.hpp"
+#include "servotwin/core/error.hpp"
 #include "servotwin/core/polynomial.hpp"
 #include "servotwin/core/transfer_function.hpp"
 
@@ -58,6 +61,17 @@ inline std::pair<double, std::complex<double>> min_damping(const core::Polynomia
 inline core::TransferFunction frictionless_tf(double r, double zeta_z) {
   return {core::Polynomial{1.0, 2.0 * zeta_z, 1.0},
           core::Polynomial{1.0, 0.0} * core::Polynomial{1.0, 2.0 * zeta_z * r * r, r * r}};
+}
+
+/// f() must throw core::InputError naming `field`, with `text` in its reason.
+inline void expect_input_error(const std::function<void()>& f, const std::string& field, const std::string& text) {
+  try {
+    f();
+    ADD_FAILURE() << "no InputError, expected one containing: " << text;
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.where().field, field);
+    EXPECT_NE(e.reason().find(text), std::string::npos) << e.reason();
+  }
 }
 
 }  // namespace servotwin::tuning::test

@@ -24,15 +24,7 @@ using test::reference;
 using test::rel_diff;
 using test::root_of;
 
-void expect_input_error(const std::function<void()>& f, const std::string& field, const std::string& text) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError, expected one containing: " << text;
-  } catch (const core::InputError& e) {
-    EXPECT_EQ(e.where().field, field);
-    EXPECT_NE(e.reason().find(text), std::string::npos) << e.reason();
-  }
-}
+using test::expect_input_error;
 
 constexpr double kNotPrinted = std::numeric_limits<double>::quiet_NaN();
 

@@ -53,15 +53,7 @@ fit::PlantModel three_mode_model() {
   return m;
 }
 
-void expect_input_error(const std::function<void()>& f, const std::string& field, const std::string& text) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError, expected one containing: " << text;
-  } catch (const core::InputError& e) {
-    EXPECT_EQ(e.where().field, field);
-    EXPECT_NE(e.reason().find(text), std::string::npos) << e.reason();
-  }
-}
+using test::expect_input_error;
 
 TEST(Normalize, E24DemoPlantPrintedParameters) {
   // E24: Im = 1, Il = 8, b = 0.2, k = 8 ⇒ ωz = 1, ξz = 0.0125, ωn = 3, ξ = 0.0375 [V].

@@ -28,15 +28,7 @@ using test::reference;
 using test::rel_diff;
 using test::root_of;
 
-void expect_input_error(const std::function<void()>& f, const std::string& field, const std::string& text) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError, expected one containing: " << text;
-  } catch (const core::InputError& e) {
-    EXPECT_EQ(e.where().field, field);
-    EXPECT_NE(e.reason().find(text), std::string::npos) << e.reason();
-  }
-}
+using test::expect_input_error;
 
 /// E24 demo plant (Im = 1, Il = 8, b = 0.2, k = 8): (1/s)(s² + 0.025 s + 1)/(s² + 0.225 s + 9).
 TransferFunction e24_plant() { return {Polynomial{1.0, 0.025, 1.0}, Polynomial{1.0, 0.225, 9.0, 0.0}}; }

@@ -23,15 +23,7 @@ using core::Polynomial;
 using test::kSqrtHalf;
 using test::reference;
 
-void expect_input_error(const std::function<void()>& f, const std::string& field, const std::string& text) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError, expected one containing: " << text;
-  } catch (const core::InputError& e) {
-    EXPECT_EQ(e.where().field, field);
-    EXPECT_NE(e.reason().find(text), std::string::npos) << e.reason();
-  }
-}
+using test::expect_input_error;
 
 PlantParameters params_of(const nlohmann::json& j) {
   return {j.at("k"), j.at("a"), j.at("xi"), j.at("xi_z"), j.at("omega"), j.at("omega_z")};
