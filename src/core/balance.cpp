@@ -46,4 +46,12 @@ Eigen::VectorXd balance(Eigen::MatrixXd& a) {
   return scale;
 }
 
+StateSpace balanced(const StateSpace& sys) {
+  StateSpace b = sys;
+  const Eigen::VectorXd t = balance(b.A);
+  b.B = t.cwiseInverse().asDiagonal() * sys.B;
+  b.C = sys.C * t.asDiagonal();
+  return b;
+}
+
 }  // namespace servotwin::core::detail

@@ -39,10 +39,7 @@ double sigma_max(const Eigen::MatrixXd& g) {
 /// The system with A balanced and B, C scaled to equal norms: same transfer matrix, and the
 /// Hamiltonian's blocks of comparable size whatever the state and signal units.
 StateSpace scaled_for_norm(const StateSpace& sys) {
-  StateSpace s = sys;
-  const Eigen::VectorXd t = detail::balance(s.A);
-  s.B = t.cwiseInverse().asDiagonal() * sys.B;
-  s.C = sys.C * t.asDiagonal();
+  StateSpace s = detail::balanced(sys);
   const double nb = s.B.norm(), nc = s.C.norm();
   if (nb > 0.0 && nc > 0.0) {
     const double beta = std::sqrt(nc / nb);

@@ -308,16 +308,6 @@ StateSpace lft_lower(const StateSpace& p, const StateSpace& k, Eigen::Index ny, 
 
 namespace {
 
-/// A system with A balanced by a diagonal similarity (A_b = T^-1 A T, B_b = T^-1 B, C_b = C T):
-/// same transfer matrix, better conditioned eigenvalues and solves for mechanically scaled models.
-StateSpace balanced(const StateSpace& sys) {
-  StateSpace b = sys;
-  const Eigen::VectorXd t = detail::balance(b.A);
-  b.B = t.cwiseInverse().asDiagonal() * sys.B;
-  b.C = sys.C * t.asDiagonal();
-  return b;
-}
-
 using Complex = std::complex<double>;
 
 std::vector<Complex> eigenvalues(const Eigen::MatrixXd& a, const char* who) {
@@ -343,7 +333,7 @@ std::pair<Polynomial, Polynomial> characteristic_polynomial(const Eigen::MatrixX
 Eigen::MatrixXd dc_gain(const StateSpace& sys) {
   check_system(sys, "dc_gain");
   if (sys.states() == 0) return sys.D;
-  const StateSpace b = balanced(sys);
+  const StateSpace b = detail::balanced(sys);
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(b.A);
   if (!(lu.rcond() >= kSingularRcond))
     throw std::domain_error("dc_gain: A is singular (a pole at s = 0), the DC gain is not finite");
@@ -356,7 +346,7 @@ TransferFunction to_transfer_function(const StateSpace& sys, Eigen::Index output
   require(input >= 0 && input < sys.inputs(), "to_transfer_function: input index out of range");
   const double d = sys.D(output, input);
   if (sys.states() == 0) return {Polynomial{d}, Polynomial{1.0}};
-  const StateSpace bal = balanced(sys);
+  const StateSpace bal = detail::balanced(sys);
   const Eigen::VectorXd b = bal.B.col(input);
   const Eigen::RowVectorXd c = bal.C.row(output);
   const auto [den, den_scale] = characteristic_polynomial(bal.A, "to_transfer_function");
