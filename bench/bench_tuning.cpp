@@ -11,6 +11,7 @@
 #include "servotwin/tuning/normalized_plant.hpp"
 #include "servotwin/tuning/pi_design.hpp"
 #include "servotwin/tuning/robustness.hpp"
+#include "servotwin/tuning/tune.hpp"
 
 namespace {
 
@@ -112,5 +113,34 @@ void BM_LargestRobustOmegaStar(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_LargestRobustOmegaStar)->Arg(30)->Arg(48)->Unit(benchmark::kMillisecond);
+
+// The whole `servotwin tune` step (issue §9: a PI/PID design with its robustness scan <= 10 ms):
+// normalization, advice, admissible range, the automatic ω* scan (24 candidates + refinement, each
+// a placement, a Routh test, two peaks and a bandwidth with the HF dynamics), the final analysis
+// (indices, margins, time responses). Arg 0: PI; 1: PI with an uncertainty weight (RP in the scan);
+// 2: PID; 3: PI + P position loop.
+void BM_TuneAutomatic(benchmark::State& state) {
+  const fit::PlantModel model = belt_axis();
+  TuneOptions o;
+  o.ms = 2.0;
+  o.mt = 2.0;
+  const double wz = 6.283185307179586 * 4.5;
+  switch (state.range(0)) {
+    case 1:
+      o.w2 = core::TransferFunction(core::Polynomial{0.5 / wz, 0.05}, core::Polynomial{1.0 / wz, 1.0});
+      break;
+    case 2:
+      o.structure = Structure::kPid;
+      break;
+    case 3:
+      o.structure = Structure::kPiP;
+      break;
+    default:
+      break;
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(tune(model, o));
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_TuneAutomatic)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -42,6 +42,7 @@ void register_predict(CLI::App& app, Action& selected);
 void register_frf(CLI::App& app, Action& selected);
 void register_fit(CLI::App& app, Action& selected);
 void register_shaper(CLI::App& app, Action& selected);
+void register_tune(CLI::App& app, Action& selected);
 
 /// Progress line on stderr (suppressed by --quiet).
 template <typename... Args>

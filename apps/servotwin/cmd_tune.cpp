@@ -1,0 +1,221 @@
+// `servotwin tune`: a cascade PI/PID (and P position loop) for a flexible drive from its fitted
+// plant model, checked against the known HF dynamics, written as controller.json.
+#include <chrono>
+#include <fmt/ranges.h>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <string>
+
+#include "command.hpp"
+#include "servotwin/core/error.hpp"
+#include "servotwin/io/controller_json.hpp"
+#include "servotwin/io/frf_csv.hpp"
+#include "servotwin/tuning/tune.hpp"
+#include "servotwin/tuning/uncertainty.hpp"
+#include "tune_input.hpp"
+
+namespace servotwin::cli {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+struct TuneArgs {
+  std::string plant;
+  std::string structure = "pi";
+  double zeta_star = 0.8;
+  std::string omega_star = "auto";
+  double target_r = 2.0;
+  std::optional<double> tau;
+  bool allow_negative_kd = false;
+  double ms = 1.5, mt = 1.5;
+  std::string w2_num, w2_den, w2_from_frf;
+  int w2_order = 1;
+  std::optional<double> current_lag, filter, delay, ts;
+  double setpoint_weight = 1.0;
+  std::string out;
+};
+
+std::optional<double> parse_omega_star(const std::string& text) {
+  if (text == "auto") return std::nullopt;
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !std::isfinite(v) || v <= 0.0) {
+    throw core::InputError(core::at_field("--omega-star"), "expected \"auto\" or omega*/omega_z > 0, got \"" + text + "\"");
+  }
+  return v;
+}
+
+/// W2 as the tightest stable envelope of the fitted model's relative error on the measured points.
+core::TransferFunction weight_from_residuals(const TuneArgs& a, const TunePlant& plant) {
+  if (!plant.fitted) {
+    throw core::InputError(core::at_field("--w2-from-frf"),
+                           "needs a fitted plant model (servotwin.plant-model/1) to compare the measurement with");
+  }
+  const core::FrequencyResponse measured = io::read_frf_file(a.w2_from_frf);
+  try {
+    const tuning::UncertaintyEnvelope e = tuning::uncertainty_weight_from_residuals(plant.model, measured, a.w2_order);
+    const auto& n = e.w2.num().coefficients();
+    const auto& d = e.w2.den().coefficients();
+    fmt::print("uncertainty weight from {}: W2(s) = ({}) / ({}) (s in rad/s), log-area {:.3g}\n", a.w2_from_frf,
+               fmt::join(n.begin(), n.end(), ", "), fmt::join(d.begin(), d.end(), ", "), e.log_area);
+    return e.w2;
+  } catch (const core::InputError& e) {
+    throw core::InputError({a.w2_from_frf, 0, 0, e.where().field}, e.reason());
+  }
+}
+
+tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
+  tuning::TuneOptions o;
+  o.structure = *tuning::structure_from_string(a.structure);
+  o.zeta_star = a.zeta_star;
+  o.omega_star = parse_omega_star(a.omega_star);
+  o.target_r = a.target_r;
+  o.tau = a.tau;
+  o.allow_negative_kd = a.allow_negative_kd;
+  o.ms = a.ms;
+  o.mt = a.mt;
+  o.setpoint_weight = a.setpoint_weight;
+  if (a.w2_num.empty() != a.w2_den.empty()) {
+    throw core::InputError(core::at_field(a.w2_num.empty() ? "--w2-num" : "--w2-den"), "give both --w2-num and --w2-den");
+  }
+  if (!a.w2_num.empty() && !a.w2_from_frf.empty()) {
+    throw core::InputError(core::at_field("--w2-from-frf"), "give either --w2-num/--w2-den or --w2-from-frf, not both");
+  }
+  if (!a.w2_num.empty()) {
+    o.w2 = core::TransferFunction(parse_coefficients(a.w2_num, "--w2-num"), parse_coefficients(a.w2_den, "--w2-den"));
+  }
+  if (!a.w2_from_frf.empty()) o.w2 = weight_from_residuals(a, plant);
+  o.hf = plant.hf;
+  // Options override what a plant description says.
+  if (a.current_lag) o.hf.current_lag_s = *a.current_lag;
+  if (a.filter) o.hf.feedback_filter_s = *a.filter;
+  if (a.delay) o.hf.delay_s = *a.delay;
+  o.ts = a.ts ? a.ts : plant.ts;
+  if (o.ts) check_sample_period(*o.ts, "--ts");
+  return o;
+}
+
+/// "inf" for a margin without a crossing.
+std::string margin(double v, const char* unit) {
+  if (std::isinf(v)) return "inf (no crossing)";
+  return fmt::format("{:.3g} {}", v, unit);
+}
+
+void print_summary(const tuning::TuneResult& r, const std::string& source) {
+  const tuning::NormalizedPlant& p = r.plant;
+  const tuning::Controller& c = r.controller;
+  const double hz = p.omega_z / kTwoPi;
+  fmt::print("{}: antiresonance {:.4g} Hz, resonance ratio r = {:.4g}, zeta_z = {:.3g}, zeta_p = {:.3g}, "
+             "rigid pole a = {:.3g} omega_z, Im = {:.5g}{}\n",
+             source, hz, p.r, p.zeta_z, p.zeta_p, p.a, p.motor_inertia,
+             p.higher_modes.empty() ? "" : fmt::format(", {} higher mode(s)", p.higher_modes.size()));
+  fmt::print("advice: {}\n", r.advice.verdict);
+  fmt::print("admissible omega*: [{:.4g}, {:.4g}] omega_z = [{:.4g}, {:.4g}] Hz (upper end: {})\n", r.range.omega_min,
+             r.range.omega_max, r.range.omega_min * hz, r.range.omega_max * hz, tuning::to_string(r.range.upper));
+  fmt::print("structure {}: omega* = {:.4g} omega_z = {:.4g} Hz, zeta* = {} ({})\n", tuning::to_string(c.structure),
+             c.design.omega_star, c.design.omega_star * hz, c.design.zeta_star, c.design.omega_star_source);
+  const tuning::PidGains& g = c.physical;
+  fmt::print("gains (model units): Kp = {:.6g}, Ki = {:.6g}", g.kp, g.ki);
+  if (g.kd != 0.0) fmt::print(", Kd = {:.6g}, tau = {:.4g} s", g.kd, g.tau);
+  fmt::print(", setpoint weight wp = {}\n", g.wp);
+  if (c.kpp_physical && c.position) {
+    fmt::print("position loop: Kpp = {:.6g} 1/s (no-overshoot limit {:.6g}{}); load-position bandwidth {:.4g} Hz, "
+               "||phi_l/T_l|| = {:.3g}\n",
+               *c.kpp_physical, c.position->kpp_nominal * p.omega_z,
+               c.position->kpp_rs ? fmt::format(", robust-stability limit {:.6g}", *c.position->kpp_rs * p.omega_z) : "",
+               c.position->bandwidth_load * hz, c.position->j2);
+  }
+  const tuning::LoopIndices& i = c.predicted;
+  fmt::print("predicted (with the known HF dynamics): {}\n", i.closed_loop_stable ? "stable" : "UNSTABLE");
+  fmt::print("  bandwidth: motor {:.4g} Hz, load {}\n", i.bandwidth_motor * hz,
+             std::isnan(i.bandwidth_load) ? std::string("n/a (higher modes: no load side)")
+                                          : fmt::format("{:.4g} Hz", i.bandwidth_load * hz));
+  fmt::print("  peaks: ||S|| = {:.3g}, ||T|| = {:.3g}, ||wl/w*|| = {:.3g}; J2 = {:.3g}\n", i.peak_s, i.peak_t, i.peak_tl, i.j2);
+  fmt::print("  margins: gain {}, phase {}, modulus {:.3g}\n", margin(i.gain_margin_db, "dB"),
+             margin(i.phase_margin_deg, "deg"), i.modulus_margin);
+  fmt::print("  step: overshoot {:.1f} %, 2 % settling {:.4g} s; load-step ITAE {:.4g} (normalized)\n",
+             100.0 * i.overshoot, p.physical_time(i.settling_time), i.itae_load_step);
+  if (c.robustness.rs) {
+    fmt::print("  robustness: ||W2 T|| = {:.4f} (RS {}), ||S||/Ms = {:.4f}, RP {:.4f} ({})\n", *c.robustness.rs,
+               *c.robustness.rs < 1.0 ? "ok" : "FAILS", *c.robustness.np, *c.robustness.rp,
+               *c.robustness.rp < 1.0 ? "ok" : "fails");
+  }
+  if (c.discrete) {
+    fmt::print("discretized at ts = {:.4g} s (Tustin{})\n", c.discrete->ts,
+               c.prewarp_rad_s ? fmt::format(", prewarped at {:.4g} Hz", *c.prewarp_rad_s / kTwoPi) : "");
+  }
+  for (const std::string& n : c.notes) fmt::print("note: {}\n", n);
+}
+
+int run(const TuneArgs& a, const GlobalOptions& global) {
+  const auto start = std::chrono::steady_clock::now();
+  TunePlant plant = load_tune_plant(a.plant);
+  const tuning::TuneOptions options = options_from(a, plant);
+  auto out = a.out.empty() ? nullptr : open_output(a.out, global);
+  tuning::TuneResult result = tuning::tune(plant.model, options);
+  for (const std::string& n : plant.notes) result.controller.notes.push_back(n);
+  print_summary(result, a.plant);
+  if (out) {
+    out->stream() << io::controller_to_json(result.controller, a.plant).dump(2) << "\n";
+    out->commit();
+    progress(global, "wrote {} ({:.0f} ms)", a.out, elapsed_ms(start));
+  }
+  return kSuccess;
+}
+
+}  // namespace
+
+void register_tune(CLI::App& app, Action& selected) {
+  auto a = std::make_shared<TuneArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "tune", "Tune a cascade PI/PID velocity loop (and P position loop) for a flexible drive from its plant model");
+  cmd->add_option("plant", a->plant,
+                  "Plant: a fitted model (servotwin.plant-model/1 from `servotwin fit`), a plant description "
+                  "(servotwin.plant/1) or a flexible preset name")
+      ->required();
+  cmd->add_option("--structure", a->structure, "pi, pid (virtual inertia, C7.5) or pi+p (P position loop over the PI)")
+      ->check(CLI::IsMember({"pi", "pid", "pi+p"}))
+      ->capture_default_str();
+  cmd->add_option("--zeta-star", a->zeta_star, "Damping of the assigned closed-loop pole pair")->capture_default_str();
+  cmd->add_option("--omega-star", a->omega_star,
+                  "Natural frequency of the assigned pair relative to the antiresonance (omega*/omega_z), or auto: "
+                  "the largest load bandwidth within --ms/--mt")
+      ->capture_default_str();
+  cmd->add_option("--target-r", a->target_r, "PID: virtual resonance ratio r-bar the derivative gain creates")
+      ->capture_default_str();
+  cmd->add_option("--tau", a->tau, "PID: derivative filter time constant [s] (default: 1/max(r, 5 omega*) in omega_z units)");
+  cmd->add_flag("--allow-negative-kd", a->allow_negative_kd, "PID: accept a negative Kd (r < r-bar: acceleration feedback)");
+  cmd->add_option("--ms", a->ms, "Limit on the sensitivity peak ||S||")->capture_default_str();
+  cmd->add_option("--mt", a->mt, "Limit on the tracking peak ||wl/w*|| (motor side without a load side)")
+      ->capture_default_str();
+  cmd->add_option("--w2-num", a->w2_num, "Uncertainty weight W2(s) numerator, descending powers of s [rad/s], e.g. \"2.6,0\"");
+  cmd->add_option("--w2-den", a->w2_den, "Uncertainty weight W2(s) denominator, e.g. \"1,15\"");
+  cmd->add_option("--w2-from-frf", a->w2_from_frf,
+                  "Uncertainty weight fitted above the model's relative error on this measured response (servotwin.frf/1); "
+                  "needs a fitted plant model")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--w2-order", a->w2_order, "Order of the fitted weight (1 or 2)")->check(CLI::IsMember({1, 2}))->capture_default_str();
+  cmd->add_option("--current-lag", a->current_lag, "Current-loop time constant [s] (evaluated, not designed for)");
+  cmd->add_option("--filter", a->filter, "Velocity-measurement filter time constant [s]");
+  cmd->add_option("--delay", a->delay, "Loop delay [s] (computation, communication, half a sample of hold)");
+  cmd->add_option("--ts", a->ts, "Drive sample period [s]: also write the Tustin-discretized controller");
+  cmd->add_option("--setpoint-weight", a->setpoint_weight, "Proportional setpoint weight wp in [0, 1] (2-DoF)")
+      ->capture_default_str();
+  cmd->add_option("-o,--out", a->out, "Write the controller (servotwin.controller/1 JSON; - for stdout)");
+  set_examples(*cmd,
+               "  servotwin tune plant_model.json -o controller.json\n"
+               "  servotwin tune plant_model.json --structure pid --target-r 2 --ts 0.000125 -o pid.json\n"
+               "  servotwin tune table-5.1 --structure pi+p --omega-star 0.4 --zeta-star 1\n"
+               "  servotwin tune plant_model.json --w2-from-frf frf.csv\n"
+               "  servotwin tune plant_model.json --delay 0.0005 --w2-num 2.6,0 --w2-den 1,15 --ms 1.6\n");
+  cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });
+}
+
+}  // namespace servotwin::cli

@@ -1,0 +1,116 @@
+#include "tune_input.hpp"
+
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <variant>
+
+#include "servotwin/core/error.hpp"
+#include "servotwin/io/plant_json.hpp"
+#include "servotwin/io/plant_model_json.hpp"
+#include "servotwin/machine/flexible_plant.hpp"
+
+namespace servotwin::cli {
+
+namespace {
+
+/// The "format" member of a JSON file, or empty when the file is not a JSON object with one (the
+/// plant-description reader then reports the problem with its position).
+std::string json_format_of(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  const nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("format") || !j["format"].is_string()) return {};
+  return j["format"].get<std::string>();
+}
+
+/// Motor velocity per torque of a plant description (the chain's, or a given TF's).
+core::TransferFunction velocity_tf(const machine::PlantConfig& config, const std::string& source) {
+  if (const auto* chain = std::get_if<machine::MassChain>(&config.model)) {
+    return machine::mass_chain_transfer_function(*chain, machine::PlantOutput::MotorVelocity);
+  }
+  const core::TransferFunction& tf = std::get<machine::TransferFunctionModel>(config.model).tf;
+  switch (config.settings.output) {
+    case machine::PlantOutput::MotorVelocity:
+      return tf;
+    case machine::PlantOutput::MotorPosition: {
+      // Position = velocity/s: the velocity function is the TF times s, i.e. the den's root at 0 removed.
+      const std::span<const double> d = tf.den().coefficients();
+      if (d.empty() || d.back() != 0.0) {
+        throw core::InputError({source, 0, 0, "den"}, "a motor-position TF must have a pole at s = 0 (the integrator)");
+      }
+      return {tf.num(), core::Polynomial(std::vector<double>(d.begin(), d.end() - 1))};
+    }
+    default:
+      throw core::InputError({source, 0, 0, "settings.output"},
+                             "the tuner needs the motor-side (collocated) response; this TF is a load-side output");
+  }
+}
+
+TunePlant from_description(const machine::PlantConfig& config, const std::string& source) {
+  TunePlant p;
+  try {
+    p.model = fit::plant_model_from_transfer_function(velocity_tf(config, source), "model");
+  } catch (const core::InputError& e) {
+    throw core::InputError({source, 0, 0, e.where().field}, e.reason());
+  }
+  const machine::PlantSettings& s = config.settings;
+  if (s.current_lag > 0.0) p.hf.current_lag_s = s.current_lag;
+  // The drive holds each command for a sample: on average half a sample of delay, on top of the
+  // configured transport delay.
+  p.hf.delay_s = (static_cast<double>(s.delay_samples) + 0.5) * s.ts;
+  p.ts = s.ts;
+  if (const auto* chain = std::get_if<machine::MassChain>(&config.model)) {
+    bool friction = false, backlash = false;
+    for (std::size_t i = 0; i < chain->masses(); ++i) friction = friction || chain->friction_of(i).active();
+    for (std::size_t i = 0; i + 1 < chain->masses(); ++i) backlash = backlash || chain->backlash_of(i) > 0.0;
+    if (friction) p.notes.push_back("Coulomb/stiction friction of the description is not in the linear design (integral action removes its steady-state error)");
+    if (backlash) p.notes.push_back("backlash of the description is not in the linear design: expect a limit cycle in the loop with it");
+  }
+  return p;
+}
+
+}  // namespace
+
+TunePlant load_tune_plant(const std::string& name_or_path) {
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(name_or_path, ec) && json_format_of(name_or_path) == io::kPlantModelFormat) {
+    TunePlant p;
+    p.model = io::load_plant_model(name_or_path).model;
+    p.fitted = true;
+    return p;
+  }
+  return from_description(io::load_plant(name_or_path), name_or_path);
+}
+
+core::Polynomial parse_coefficients(const std::string& text, const std::string& option) {
+  std::string cleaned = text;
+  for (char& ch : cleaned) {
+    if (ch == ',') ch = ' ';
+  }
+  std::istringstream in(cleaned);
+  std::vector<double> c;
+  std::string token;
+  while (in >> token) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(token, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != token.size() || !std::isfinite(v)) {
+      throw core::InputError(core::at_field(option),
+                             fmt::format("expected coefficients in descending powers of s (e.g. \"2.6,0\"), got \"{}\"", token));
+    }
+    c.push_back(v);
+  }
+  const core::Polynomial p(c);
+  if (p.is_zero()) throw core::InputError(core::at_field(option), "expected at least one non-zero coefficient");
+  return p;
+}
+
+}  // namespace servotwin::cli

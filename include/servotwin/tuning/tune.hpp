@@ -1,0 +1,67 @@
+#pragma once
+/// \file
+/// The one-call tuner that `servotwin tune` runs (issue-7 plan §3.2 tune.hpp): from a fitted plant
+/// model to a checked cascade controller.
+///
+/// Pipeline: normalize the model (known HF dynamics set aside: designed without, evaluated with),
+/// give the C7.4 advice for its resonance ratio, find the admissible ω* range of the assigned pair
+/// (C7.3), then choose ω* — the user's, or automatically the one that maximizes the load bandwidth
+/// (J1, C7.8) while the loop evaluated WITH the HF dynamics is stable and keeps ‖S‖∞ <= Ms and the
+/// tracking peak ‖ωl/ω*‖∞ <= Mt (‖ωm/ω*‖∞ when there is no load side) — then place the pair (PI)
+/// or the virtual-inertia PID (C7.5), add the P position loop (C7.10) for pi+p, and analyse the
+/// result (indices, margins, time responses).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "servotwin/core/transfer_function.hpp"
+#include "servotwin/fit/plant_model.hpp"
+#include "servotwin/tuning/controller.hpp"
+#include "servotwin/tuning/loop_analysis.hpp"
+#include "servotwin/tuning/normalized_plant.hpp"
+#include "servotwin/tuning/pi_design.hpp"
+
+namespace servotwin::tuning {
+
+/// What the user asks for. Frequencies of ω* are normalized (ω*/ωz); HF dynamics and ts physical.
+struct TuneOptions {
+  Structure structure = Structure::kPi;
+  double zeta_star = 0.8;               ///< damping of the assigned pair (C7.3)
+  std::optional<double> omega_star;     ///< ω*/ωz; std::nullopt: automatic (J1 under Ms, Mt)
+  double target_r = 2.0;                ///< PID: the virtual resonance ratio r̄ (C7.5)
+  std::optional<double> tau;            ///< PID derivative filter [s]; default plan §1.5
+  bool allow_negative_kd = false;       ///< PID with r < r̄ (acceleration feedback)
+  double ms = 1.5;                      ///< ‖S‖∞ limit
+  double mt = 1.5;                      ///< tracking peak limit
+  /// Multiplicative uncertainty weight W2(s) in physical s [rad/s]: when given, automatic ω* also
+  /// requires robust performance sup(|S|/Ms + |W2 T|) < 1 and the result reports RS/NP/RP.
+  std::optional<core::TransferFunction> w2;
+  HfDynamics hf;                        ///< known HF dynamics, physical units
+  std::optional<double> ts;             ///< drive sample period [s]: discretize the controller
+  double setpoint_weight = 1.0;         ///< wp of the 2-DoF PI/PID
+  std::size_t scan_points = 24;         ///< automatic ω*: candidates on the admissible range
+};
+
+/// Everything the tuner found, for the CLI summary, the controller file and the report.
+struct TuneResult {
+  NormalizedPlant plant;            ///< the normalized design plant (HF dynamics in hf)
+  ResonanceRatioAdvice advice;      ///< C7.4 verdict for r
+  AdmissibleRange range;            ///< admissible ω* of the assigned pair
+  Controller controller;            ///< the tuned controller (physical and normalized)
+  /// Automatic ω*: the scanned candidates (ω*, load bandwidth, ‖S‖∞, tracking peak, feasible).
+  struct Candidate {
+    double omega_star = 0.0, bandwidth = 0.0, peak_s = 0.0, peak_tracking = 0.0;
+    bool stable = false, feasible = false;
+  };
+  std::vector<Candidate> scan;
+};
+
+/// Runs the pipeline. Throws core::InputError for a plant that cannot be tuned this way (from
+/// normalize(): no mode, unstable, non-minimum-phase, r <= 1.05) with the fix in the message; for
+/// options out of range (named by their CLI flag); for r < 1.3 ("recommend passive methods":
+/// a notch or input shaper); for an empty admissible range; and when no ω* meets Ms/Mt (the
+/// message gives the best achievable peaks).
+[[nodiscard]] TuneResult tune(const fit::PlantModel& model, const TuneOptions& options);
+
+}  // namespace servotwin::tuning

@@ -1,0 +1,632 @@
+#include "servotwin/io/controller_json.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include "json_reader.hpp"
+#include "servotwin/core/error.hpp"
+#include "servotwin/io/machine_json.hpp"
+
+namespace servotwin::io {
+
+namespace {
+
+using detail::JsonObject;
+using nlohmann::json;
+using tuning::Structure;
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+/// Agreement demanded between redundant members (gains vs normalized gains, state spaces vs gains,
+/// derived `_hz`/`_s` members): far above the rounding of a written and re-read double, far below
+/// any deliberate edit.
+constexpr double kRelTol = 1e-6;
+constexpr std::array<const char*, 2> kInputNames = {"velocity_reference", "motor_velocity"};
+
+std::string show(double v) { return fmt::format("{:.9g}", v); }
+
+bool agree(double given, double expected) {
+  return std::abs(given - expected) <= kRelTol * std::max(std::abs(given), std::abs(expected));
+}
+
+std::string loop_name(Structure s) { return s == Structure::kPiP ? "position" : "velocity"; }
+
+// ---------------------------------------------------------------- writer
+
+/// A value that must be finite: JSON would silently write NaN and infinity as null.
+double finite(double v, const std::string& field) {
+  if (!std::isfinite(v))
+    throw std::invalid_argument("controller_to_json: " + field + " is not finite (" + show(v) + ")");
+  return v;
+}
+
+json optional_finite(const std::optional<double>& v, const std::string& field) {
+  return v ? json(finite(*v, field)) : json(nullptr);
+}
+
+/// Finite numbers as numbers, ±infinity as "inf"/"-inf", NaN (undefined) as null.
+json extended(double v) {
+  if (std::isnan(v)) return nullptr;
+  if (std::isinf(v)) return v > 0.0 ? "inf" : "-inf";
+  return v;
+}
+
+json matrix_json(const Eigen::MatrixXd& m, const std::string& field) {
+  json rows = json::array();
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    json row = json::array();
+    for (Eigen::Index j = 0; j < m.cols(); ++j)
+      row.push_back(finite(m(i, j), field + "[" + std::to_string(i) + "][" + std::to_string(j) + "]"));
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+json gains_json(const tuning::PidGains& g, const std::optional<double>& kpp, const std::string& section) {
+  return {{"kp", finite(g.kp, section + ".kp")},          {"ki", finite(g.ki, section + ".ki")},
+          {"kd", finite(g.kd, section + ".kd")},          {"tau", finite(g.tau, section + ".tau")},
+          {"wp", finite(g.wp, section + ".wp")},          {"wd", finite(g.wd, section + ".wd")},
+          {"kpp", optional_finite(kpp, section + ".kpp")}};
+}
+
+/// How a LoopIndices member scales to physical units: frequencies get a `_hz` twin (× ωz/2π),
+/// times a `_s` twin (/ ωz); the rest are dimensionless or stay normalized.
+enum class Scale { kNone, kFrequency, kTime };
+
+struct IndexField {
+  const char* name;
+  double tuning::LoopIndices::*member;
+  Scale scale;
+};
+
+using tuning::LoopIndices;
+/// Every numeric member of tuning::LoopIndices, in the struct's order.
+constexpr std::array kIndexFields{
+    IndexField{"bandwidth_motor", &LoopIndices::bandwidth_motor, Scale::kFrequency},
+    IndexField{"bandwidth_load", &LoopIndices::bandwidth_load, Scale::kFrequency},
+    IndexField{"peak_s", &LoopIndices::peak_s, Scale::kNone},
+    IndexField{"peak_s_omega", &LoopIndices::peak_s_omega, Scale::kFrequency},
+    IndexField{"peak_t", &LoopIndices::peak_t, Scale::kNone},
+    IndexField{"peak_tm", &LoopIndices::peak_tm, Scale::kNone},
+    IndexField{"peak_tl", &LoopIndices::peak_tl, Scale::kNone},
+    IndexField{"peak_load_disturbance", &LoopIndices::peak_load_disturbance, Scale::kNone},
+    IndexField{"j2", &LoopIndices::j2, Scale::kNone},
+    IndexField{"gain_margin_db", &LoopIndices::gain_margin_db, Scale::kNone},
+    IndexField{"phase_crossover", &LoopIndices::phase_crossover, Scale::kFrequency},
+    IndexField{"phase_margin_deg", &LoopIndices::phase_margin_deg, Scale::kNone},
+    IndexField{"gain_crossover", &LoopIndices::gain_crossover, Scale::kFrequency},
+    IndexField{"modulus_margin", &LoopIndices::modulus_margin, Scale::kNone},
+    IndexField{"overshoot", &LoopIndices::overshoot, Scale::kNone},
+    IndexField{"settling_time", &LoopIndices::settling_time, Scale::kTime},
+    IndexField{"overshoot_motor", &LoopIndices::overshoot_motor, Scale::kNone},
+    IndexField{"settling_time_motor", &LoopIndices::settling_time_motor, Scale::kTime},
+    IndexField{"itae_load_step", &LoopIndices::itae_load_step, Scale::kNone},
+    IndexField{"peak_torque_step", &LoopIndices::peak_torque_step, Scale::kNone},
+    IndexField{"hf_controller_gain", &LoopIndices::hf_controller_gain, Scale::kNone},
+    IndexField{"min_damping", &LoopIndices::min_damping, Scale::kNone},
+    IndexField{"sample_time", &LoopIndices::sample_time, Scale::kTime},
+    IndexField{"horizon", &LoopIndices::horizon, Scale::kTime},
+};
+
+/// The physical twin of a scaled index: its name and factor (normalized × factor = physical).
+std::pair<std::string, double> physical_twin(const IndexField& f, double omega_z) {
+  if (f.scale == Scale::kFrequency) return {std::string(f.name) + "_hz", omega_z / kTwoPi};
+  return {std::string(f.name) + "_s", 1.0 / omega_z};
+}
+
+json predicted_json(const LoopIndices& p, double omega_z) {
+  json j = {{"closed_loop_stable", p.closed_loop_stable}};
+  for (const IndexField& f : kIndexFields) {
+    const double v = p.*f.member;
+    j[f.name] = extended(v);
+    if (f.scale == Scale::kNone) continue;
+    const auto [twin, factor] = physical_twin(f, omega_z);
+    j[twin] = extended(v * factor);
+  }
+  json poles = json::array();
+  for (std::size_t i = 0; i < p.closed_loop_poles.size(); ++i) {
+    const std::string field = "predicted.closed_loop_poles[" + std::to_string(i) + "]";
+    poles.push_back({finite(p.closed_loop_poles[i].real(), field), finite(p.closed_loop_poles[i].imag(), field)});
+  }
+  j["closed_loop_poles"] = poles;
+  return j;
+}
+
+json robustness_json(const tuning::RobustnessSummary& r) {
+  const auto put = [](const std::optional<double>& v, const char* name) {
+    if (!v) return json(nullptr);
+    if (std::isnan(*v)) throw std::invalid_argument(std::string("controller_to_json: robustness.") + name + " is NaN");
+    return extended(*v);
+  };
+  return {{"rs", put(r.rs, "rs")}, {"np", put(r.np, "np")}, {"rp", put(r.rp, "rp")}};
+}
+
+json position_json(const std::optional<tuning::PositionSummary>& p, double omega_z) {
+  if (!p) return nullptr;
+  return {{"kpp_nominal", finite(p->kpp_nominal, "position.kpp_nominal")},
+          {"kpp_rs", optional_finite(p->kpp_rs, "position.kpp_rs")},
+          {"kpp_rp_exact", optional_finite(p->kpp_rp_exact, "position.kpp_rp_exact")},
+          {"bandwidth_load", finite(p->bandwidth_load, "position.bandwidth_load")},
+          {"bandwidth_load_hz", p->bandwidth_load * omega_z / kTwoPi},
+          {"j2", finite(p->j2, "position.j2")},
+          {"peak_load_tracking", finite(p->peak_load_tracking, "position.peak_load_tracking")}};
+}
+
+// ---------------------------------------------------------------- reader
+
+/// A JSON object with its raw value, for members that JsonObject does not type (matrices,
+/// nullable and extended numbers).
+struct Section {
+  const json& value;
+  JsonObject object;
+
+  Section(const json& v, std::string path, std::string_view source) : value(v), object(v, std::move(path), source) {}
+
+  [[nodiscard]] const json& raw(std::string_view key) const {
+    const auto it = value.find(key);
+    if (it == value.end()) object.fail(key, "missing required field");
+    return *it;
+  }
+  [[nodiscard]] Section section(std::string_view key) const {
+    return Section(raw(key), object.member_path(key), object.source());
+  }
+  [[noreturn]] void fail(std::string_view key, const std::string& message) const { object.fail(key, message); }
+
+  [[nodiscard]] double number(std::string_view key) const { return object.number(key); }
+  [[nodiscard]] double positive(std::string_view key, const char* what) const {
+    const double v = number(key);
+    if (!(v > 0.0)) fail(key, std::string("expected ") + what + " > 0, got " + show(v));
+    return v;
+  }
+  [[nodiscard]] double non_negative(std::string_view key, const char* what) const {
+    const double v = number(key);
+    if (!(v >= 0.0)) fail(key, std::string("expected ") + what + " >= 0, got " + show(v));
+    return v;
+  }
+  [[nodiscard]] bool boolean(std::string_view key) const {
+    const json& v = raw(key);
+    if (!v.is_boolean()) fail(key, std::string("expected true or false, found ") + v.type_name());
+    return v.get<bool>();
+  }
+  /// A number, "inf", "-inf", or null (NaN: undefined).
+  [[nodiscard]] double extended(std::string_view key) const {
+    const json& v = raw(key);
+    if (v.is_null()) return std::numeric_limits<double>::quiet_NaN();
+    if (v.is_string()) {
+      const auto s = v.get<std::string>();
+      if (s == "inf") return std::numeric_limits<double>::infinity();
+      if (s == "-inf") return -std::numeric_limits<double>::infinity();
+      fail(key, "expected a number, \"inf\", \"-inf\" or null, got \"" + s + "\"");
+    }
+    return number(key);
+  }
+  /// A finite number or null (required member).
+  [[nodiscard]] std::optional<double> nullable(std::string_view key) const {
+    if (raw(key).is_null()) return std::nullopt;
+    return number(key);
+  }
+  /// A string equal to `expected`.
+  void expect_string(std::string_view key, std::string_view expected) const {
+    const std::string s = object.string(key);
+    if (s != expected) fail(key, "expected \"" + std::string(expected) + "\", got \"" + s + "\"");
+  }
+};
+
+/// Array of rows, every row as long as the first, finite numbers; `rows`/`cols` < 0: any (>= 1).
+Eigen::MatrixXd read_matrix(const Section& s, std::string_view key, Eigen::Index rows, Eigen::Index cols) {
+  const std::string name(key);
+  const json& m = s.raw(key);
+  const auto shape = [](Eigen::Index r, Eigen::Index c) {
+    return (r < 0 ? std::string("n") : std::to_string(r)) + "x" + (c < 0 ? std::string("n") : std::to_string(c));
+  };
+  if (!m.is_array() || m.empty() || !m[0].is_array() || m[0].empty())
+    s.fail(key, "expected a non-empty array of rows (a " + shape(rows, cols) + " matrix)");
+  const auto r = static_cast<Eigen::Index>(m.size());
+  const auto c = static_cast<Eigen::Index>(m[0].size());
+  if ((rows >= 0 && r != rows) || (cols >= 0 && c != cols))
+    s.fail(key, "expected a " + shape(rows, cols) + " matrix, got " + std::to_string(r) + "x" + std::to_string(c));
+  Eigen::MatrixXd out(r, c);
+  for (Eigen::Index i = 0; i < r; ++i) {
+    const json& row = m[static_cast<std::size_t>(i)];
+    const std::string row_key = name + "[" + std::to_string(i) + "]";
+    if (!row.is_array() || static_cast<Eigen::Index>(row.size()) != c)
+      s.fail(row_key, "expected a row of " + std::to_string(c) + " numbers (as the first row)");
+    for (Eigen::Index j = 0; j < c; ++j) {
+      const json& v = row[static_cast<std::size_t>(j)];
+      if (!v.is_number() || !std::isfinite(v.get<double>()))
+        s.fail(row_key + "[" + std::to_string(j) + "]", "expected a finite number, found " + v.dump());
+      out(i, j) = v.get<double>();
+    }
+  }
+  return out;
+}
+
+/// A, B, C, D of a controller with the two inputs and one output.
+void read_matrices(const Section& s, Eigen::MatrixXd& a, Eigen::MatrixXd& b, Eigen::MatrixXd& c, Eigen::MatrixXd& d) {
+  a = read_matrix(s, "A", -1, -1);
+  if (a.rows() != a.cols())
+    s.fail("A", "expected a square matrix, got " + std::to_string(a.rows()) + "x" + std::to_string(a.cols()));
+  b = read_matrix(s, "B", a.rows(), 2);
+  c = read_matrix(s, "C", 1, a.rows());
+  d = read_matrix(s, "D", 1, 2);
+}
+
+/// The file's system must have the response of the system the gains define at every `omegas`
+/// (rad/s): relative to the larger channel, so a channel that is (nearly) zero is judged against
+/// the other. `response(sys, ω)` evaluates a 1×2 response.
+template <typename System, typename Response>
+void check_realization(const Section& parent, std::string_view key, const System& file, const System& expected,
+                       const std::vector<double>& omegas, Response response) {
+  for (double w : omegas) {
+    const Eigen::MatrixXcd g = response(file, w);
+    const Eigen::MatrixXcd e = response(expected, w);
+    const double scale = std::max(std::abs(e(0, 0)), std::abs(e(0, 1)));
+    for (Eigen::Index k = 0; k < 2; ++k) {
+      const std::complex<double> diff = g(0, k) - e(0, k);
+      if (!(std::abs(diff) <= kRelTol * scale))
+        parent.fail(key, fmt::format("does not realize the controller of \"gains\": at {} Hz the response from {} is "
+                                     "{}{:+.9g}j, the gains give {}{:+.9g}j (agreement within {} relative expected)",
+                                     show(w / kTwoPi), kInputNames[static_cast<std::size_t>(k)], show(g(0, k).real()),
+                                     g(0, k).imag(), show(e(0, k).real()), e(0, k).imag(), kRelTol));
+    }
+  }
+}
+
+struct GainsRead {
+  tuning::PidGains gains;
+  std::optional<double> kpp;
+};
+
+GainsRead read_gains(const Section& s, Structure structure) {
+  s.object.allow_only({"kp", "ki", "kd", "tau", "wp", "wd", "kpp"});
+  GainsRead out;
+  tuning::PidGains& g = out.gains;
+  g.kp = s.number("kp");
+  g.ki = s.number("ki");
+  g.kd = s.number("kd");
+  g.tau = s.non_negative("tau", "a derivative filter time constant");
+  for (const auto& [key, weight] : {std::pair{"wp", &g.wp}, std::pair{"wd", &g.wd}}) {
+    *weight = s.number(key);
+    if (!(*weight >= 0.0 && *weight <= 1.0)) s.fail(key, "expected a setpoint weight in [0, 1], got " + show(*weight));
+  }
+  if (structure == Structure::kPid) {
+    if (!(g.tau > 0.0))
+      s.fail("tau", "a pid needs a derivative filter time constant > 0 (an ideal derivative has no state space)");
+  } else {
+    const std::string name = to_string(structure);
+    if (g.kd != 0.0)
+      s.fail("kd", "expected 0 for a \"" + name + "\" controller (only \"pid\" has a derivative), got " + show(g.kd));
+    if (g.tau != 0.0)
+      s.fail("tau", "expected 0 for a \"" + name + "\" controller (only \"pid\" has a derivative), got " + show(g.tau));
+  }
+  out.kpp = s.nullable("kpp");
+  if (structure == Structure::kPiP) {
+    if (!out.kpp || !(*out.kpp > 0.0)) s.fail("kpp", "expected a position gain > 0 for a \"pi+p\" controller");
+  } else if (out.kpp) {
+    s.fail("kpp", "expected null: only a \"pi+p\" controller has a position gain");
+  }
+  return out;
+}
+
+/// gains.<key> must be normalized.<key> de-normalized.
+void check_scaled(const Section& s, const char* key, double physical, double expected, const char* rule) {
+  if (!agree(physical, expected))
+    s.fail(key, "is " + show(physical) + " but normalized." + key + " de-normalized with the plant scales (" + rule +
+                    ") gives " + show(expected) + " (agreement within 1e-6 relative expected)");
+}
+
+void check_gains_agree(const Section& s, const GainsRead& physical, const GainsRead& normalized,
+                       const tuning::PlantScales& scales) {
+  tuning::NormalizedPlant plant;
+  plant.omega_z = scales.omega_z;
+  plant.motor_inertia = scales.motor_inertia;
+  const tuning::PidGains e = tuning::to_physical(normalized.gains, plant);
+  const tuning::PidGains& g = physical.gains;
+  check_scaled(s, "kp", g.kp, e.kp, "Kp = Kp_n·Im·ωz");
+  check_scaled(s, "ki", g.ki, e.ki, "Ki = Ki_n·Im·ωz²");
+  check_scaled(s, "kd", g.kd, e.kd, "Kd = Kd_n·Im");
+  check_scaled(s, "tau", g.tau, e.tau, "τ = τ_n/ωz");
+  check_scaled(s, "wp", g.wp, e.wp, "the same weight");
+  check_scaled(s, "wd", g.wd, e.wd, "the same weight");
+  if (physical.kpp) check_scaled(s, "kpp", *physical.kpp, *normalized.kpp * scales.omega_z, "Kpp = Kpp_n·ωz");
+}
+
+tuning::PlantScales read_plant(const Section& s, std::string& source) {
+  s.object.allow_only({"source", "omega_z_hz", "motor_inertia", "r", "zeta_z", "zeta_p", "a"});
+  source = s.object.string("source");
+  tuning::PlantScales p;
+  p.omega_z = kTwoPi * s.positive("omega_z_hz", "an antiresonance frequency [Hz]");
+  p.motor_inertia = s.positive("motor_inertia", "a motor inertia");
+  p.r = s.number("r");
+  if (!(p.r > 1.0)) s.fail("r", "expected a resonance ratio > 1 (antiresonance below resonance), got " + show(p.r));
+  p.zeta_z = s.non_negative("zeta_z", "a damping ratio");
+  p.zeta_p = s.non_negative("zeta_p", "a damping ratio");
+  p.a = s.non_negative("a", "a normalized rigid pole");
+  return p;
+}
+
+/// A member derived from a normalized one: `derived` = `base` · factor, with the same non-finite class.
+void check_derived(const Section& s, const char* derived, const char* base, double base_value, double factor,
+                   const char* relation) {
+  const double given = s.extended(derived);
+  const double expected = base_value * factor;
+  const bool ok = std::isnan(expected)   ? std::isnan(given)
+                  : std::isinf(expected) ? given == expected
+                                         : std::isfinite(given) && agree(given, expected);
+  if (!ok)
+    s.fail(derived, "is " + json(extended(given)).dump() + " but " + base + " " + relation + " gives " +
+                        json(extended(expected)).dump() + " (agreement within 1e-6 relative expected)");
+}
+
+tuning::DesignParameters read_design(const Section& s, double omega_z) {
+  s.object.allow_only({"omega_star", "omega_star_hz", "zeta_star", "r_target", "ms", "mt", "omega_star_source"});
+  tuning::DesignParameters d;
+  d.omega_star = s.positive("omega_star", "a normalized bandwidth ω*/ωz");
+  check_derived(s, "omega_star_hz", "omega_star", d.omega_star, omega_z / kTwoPi, "× ωz/2π");
+  d.zeta_star = s.positive("zeta_star", "a damping ratio");
+  d.r_target = s.nullable("r_target");
+  if (d.r_target && !(*d.r_target > 1.0))
+    s.fail("r_target", "expected a target resonance ratio > 1 or null, got " + show(*d.r_target));
+  for (const char* key : {"ms", "mt"}) {
+    const std::optional<double> v = s.nullable(key);
+    if (v && !(*v >= 1.0)) s.fail(key, "expected a peak limit >= 1 or null, got " + show(*v));
+    (std::string(key) == "ms" ? d.ms : d.mt) = v;
+  }
+  d.omega_star_source = s.object.string("omega_star_source");
+  return d;
+}
+
+LoopIndices read_predicted(const Section& s, double omega_z) {
+  std::vector<std::string> known = {"closed_loop_stable", "closed_loop_poles"};
+  for (const IndexField& f : kIndexFields) {
+    known.emplace_back(f.name);
+    if (f.scale != Scale::kNone) known.push_back(physical_twin(f, omega_z).first);
+  }
+  for (const auto& [key, value] : s.value.items()) {
+    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    std::string list;
+    for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+    s.fail(key, "unknown field (expected one of: " + list + ")");
+  }
+  LoopIndices p;
+  p.closed_loop_stable = s.boolean("closed_loop_stable");
+  for (const IndexField& f : kIndexFields) {
+    p.*f.member = s.extended(f.name);
+    if (f.scale == Scale::kNone) continue;
+    const auto [twin, factor] = physical_twin(f, omega_z);
+    check_derived(s, twin.c_str(), f.name, p.*f.member, factor, f.scale == Scale::kFrequency ? "× ωz/2π" : "/ ωz");
+  }
+
+  const json& poles = s.raw("closed_loop_poles");
+  if (!poles.is_array()) s.fail("closed_loop_poles", "expected an array of [re, im] pairs");
+  for (std::size_t i = 0; i < poles.size(); ++i) {
+    const json& e = poles[i];
+    const bool pair = e.is_array() && e.size() == 2 && e[0].is_number() && e[1].is_number() &&
+                      std::isfinite(e[0].get<double>()) && std::isfinite(e[1].get<double>());
+    if (!pair)
+      s.fail("closed_loop_poles[" + std::to_string(i) + "]",
+             "expected a pair [re, im] of finite numbers, found " + e.dump());
+    p.closed_loop_poles.emplace_back(e[0].get<double>(), e[1].get<double>());
+  }
+  return p;
+}
+
+/// The position-loop section: null for the velocity structures, an object for pi+p.
+std::optional<tuning::PositionSummary> read_position(const Section& root, Structure structure, double omega_z) {
+  const bool present = !root.raw("position").is_null();
+  if (present != (structure == Structure::kPiP))
+    root.fail("position", structure == Structure::kPiP ? "a \"pi+p\" controller needs its position-loop section"
+                                                       : "only a \"pi+p\" controller has a position-loop section (expected null)");
+  if (!present) return std::nullopt;
+  const Section s = root.section("position");
+  s.object.allow_only({"kpp_nominal", "kpp_rs", "kpp_rp_exact", "bandwidth_load", "bandwidth_load_hz", "j2",
+                       "peak_load_tracking"});
+  tuning::PositionSummary p;
+  p.kpp_nominal = s.positive("kpp_nominal", "a position gain");
+  for (const char* key : {"kpp_rs", "kpp_rp_exact"}) {
+    const std::optional<double> v = s.nullable(key);
+    if (v && !(*v >= 0.0)) s.fail(key, "expected a position gain >= 0 or null, got " + show(*v));
+    (std::string(key) == "kpp_rs" ? p.kpp_rs : p.kpp_rp_exact) = v;
+  }
+  p.bandwidth_load = s.non_negative("bandwidth_load", "a normalized bandwidth");
+  check_derived(s, "bandwidth_load_hz", "bandwidth_load", p.bandwidth_load, omega_z / kTwoPi, "× ωz/2π");
+  p.j2 = s.non_negative("j2", "a peak gain");
+  p.peak_load_tracking = s.non_negative("peak_load_tracking", "a peak gain");
+  return p;
+}
+
+tuning::RobustnessSummary read_robustness(const Section& s) {
+  s.object.allow_only({"rs", "np", "rp"});
+  const auto read = [&](const char* key) -> std::optional<double> {
+    if (s.raw(key).is_null()) return std::nullopt;
+    const double v = s.extended(key);
+    if (!(v >= 0.0)) s.fail(key, "expected a norm >= 0, \"inf\" or null (not evaluated), got " + show(v));
+    return v;
+  };
+  tuning::RobustnessSummary r;
+  r.rs = read("rs");
+  r.np = read("np");
+  r.rp = read("rp");
+  return r;
+}
+
+/// Frequencies [rad/s] at which the continuous realization is compared: four decades around ωz
+/// (the design band) and the derivative filter's corner.
+std::vector<double> continuous_check_frequencies(double omega_z, const tuning::PidGains& g) {
+  std::vector<double> w;
+  for (double k : {0.01, 0.1, 0.5, 1.0, 2.0, 10.0, 100.0}) w.push_back(k * omega_z);
+  if (g.tau > 0.0) w.push_back(1.0 / g.tau);
+  return w;
+}
+
+void read_state_space(const Section& root, const tuning::PidGains& physical, double omega_z) {
+  const Section s = root.section("state_space");
+  s.object.allow_only({"inputs", "output", "A", "B", "C", "D"});
+  const json& inputs = s.raw("inputs");
+  if (inputs != json(kInputNames))
+    s.fail("inputs", "expected [\"velocity_reference\", \"motor_velocity\"], got " + inputs.dump());
+  s.expect_string("output", "torque");
+  core::StateSpace file;
+  read_matrices(s, file.A, file.B, file.C, file.D);
+  const core::StateSpace expected = tuning::controller_state_space(physical);
+  const auto response = [](const core::StateSpace& sys, double w) { return core::frequency_response(sys, w); };
+  check_realization(root, "state_space", file, expected, continuous_check_frequencies(omega_z, physical), response);
+}
+
+std::optional<core::DiscreteStateSpace> read_discrete(const Section& root, const tuning::PidGains& physical,
+                                                      std::optional<double>& prewarp_rad_s) {
+  if (root.raw("discrete").is_null()) return std::nullopt;
+  const Section s = root.section("discrete");
+  s.object.allow_only({"ts", "method", "prewarp_hz", "A", "B", "C", "D"});
+  const double ts = s.positive("ts", "a sample period [s]");
+  s.expect_string("method", "tustin");
+  const double nyquist_hz = 0.5 / ts;
+  if (const auto prewarp_hz = s.nullable("prewarp_hz")) {
+    if (!(*prewarp_hz > 0.0 && *prewarp_hz < nyquist_hz))
+      s.fail("prewarp_hz", "expected a frequency in (0, " + show(nyquist_hz) + ") Hz (below Nyquist) or null, got " +
+                               show(*prewarp_hz));
+    prewarp_rad_s = kTwoPi * *prewarp_hz;
+  }
+  core::DiscreteStateSpace file;
+  file.ts = ts;
+  read_matrices(s, file.A, file.B, file.C, file.D);
+  const core::DiscreteStateSpace expected = tuning::discretize_controller(physical, ts, prewarp_rad_s);
+  std::vector<double> omegas;
+  for (double k : {1e-3, 1e-2, 0.1, 0.3, 0.6, 0.9}) omegas.push_back(k * kTwoPi * nyquist_hz);
+  if (prewarp_rad_s) omegas.push_back(*prewarp_rad_s);
+  const auto response = [](const core::DiscreteStateSpace& sys, double w) { return core::frequency_response(sys, w); };
+  check_realization(root, "discrete", file, expected, omegas, response);
+  return file;
+}
+
+std::vector<std::string> read_notes(const Section& root) {
+  const json& notes = root.raw("notes");
+  if (!notes.is_array()) root.fail("notes", std::string("expected an array of strings, found ") + notes.type_name());
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < notes.size(); ++i) {
+    if (!notes[i].is_string())
+      root.fail("notes[" + std::to_string(i) + "]", "expected a string, found " + notes[i].dump());
+    out.push_back(notes[i].get<std::string>());
+  }
+  return out;
+}
+
+}  // namespace
+
+json controller_to_json(const tuning::Controller& c, std::string_view plant_source) {
+  const bool position = c.structure == Structure::kPiP;
+  if (position != c.kpp_physical.has_value() || position != c.kpp_normalized.has_value())
+    throw std::invalid_argument("controller_to_json: a position gain kpp belongs to exactly the \"pi+p\" controllers");
+  if (position != c.position.has_value())
+    throw std::invalid_argument("controller_to_json: the position-loop summary belongs to exactly the \"pi+p\" controllers");
+  const double wz = finite(c.plant.omega_z, "plant.omega_z");
+  const tuning::PlantScales& p = c.plant;
+  const core::StateSpace ss = tuning::controller_state_space(c.physical);
+  json discrete = nullptr;
+  if (c.discrete) {
+    const core::DiscreteStateSpace& d = *c.discrete;
+    discrete = {
+        {"ts", finite(d.ts, "discrete.ts")},
+        {"method", "tustin"},
+        {"prewarp_hz", c.prewarp_rad_s ? json(finite(*c.prewarp_rad_s, "prewarp_rad_s") / kTwoPi) : json(nullptr)},
+        {"A", matrix_json(d.A, "discrete.A")},
+        {"B", matrix_json(d.B, "discrete.B")},
+        {"C", matrix_json(d.C, "discrete.C")},
+        {"D", matrix_json(d.D, "discrete.D")}};
+  }
+  const tuning::DesignParameters& d = c.design;
+  return {{"format", kControllerFormat},
+          {"structure", to_string(c.structure)},
+          {"loop", loop_name(c.structure)},
+          {"feedback", "motor"},
+          {"plant",
+           {{"source", std::string(plant_source)},
+            {"omega_z_hz", wz / kTwoPi},
+            {"motor_inertia", finite(p.motor_inertia, "plant.motor_inertia")},
+            {"r", finite(p.r, "plant.r")},
+            {"zeta_z", finite(p.zeta_z, "plant.zeta_z")},
+            {"zeta_p", finite(p.zeta_p, "plant.zeta_p")},
+            {"a", finite(p.a, "plant.a")}}},
+          {"gains", gains_json(c.physical, c.kpp_physical, "gains")},
+          {"normalized", gains_json(c.normalized, c.kpp_normalized, "normalized")},
+          {"state_space",
+           {{"inputs", kInputNames},
+            {"output", "torque"},
+            {"A", matrix_json(ss.A, "state_space.A")},
+            {"B", matrix_json(ss.B, "state_space.B")},
+            {"C", matrix_json(ss.C, "state_space.C")},
+            {"D", matrix_json(ss.D, "state_space.D")}}},
+          {"discrete", discrete},
+          {"design",
+           {{"omega_star", finite(d.omega_star, "design.omega_star")},
+            {"omega_star_hz", d.omega_star * wz / kTwoPi},
+            {"zeta_star", finite(d.zeta_star, "design.zeta_star")},
+            {"r_target", optional_finite(d.r_target, "design.r_target")},
+            {"ms", optional_finite(d.ms, "design.ms")},
+            {"mt", optional_finite(d.mt, "design.mt")},
+            {"omega_star_source", d.omega_star_source}}},
+          {"predicted", predicted_json(c.predicted, wz)},
+          {"robustness", robustness_json(c.robustness)},
+          {"position", position_json(c.position, wz)},
+          {"notes", c.notes}};
+}
+
+LoadedController parse_controller_json(std::string_view text, std::string_view source_name) {
+  const json document = detail::parse_json_text(text, source_name);
+  check_format(document, kControllerFormat, source_name);
+  const Section root(document, "", source_name);
+  root.object.allow_only({"format", "structure", "loop", "feedback", "plant", "gains", "normalized", "state_space",
+                          "discrete", "design", "predicted", "robustness", "position", "notes"});
+  LoadedController out;
+  tuning::Controller& c = out.controller;
+
+  const std::string structure = root.object.string("structure");
+  const auto parsed = tuning::structure_from_string(structure);
+  if (!parsed) root.fail("structure", "expected \"pi\", \"pid\" or \"pi+p\", got \"" + structure + "\"");
+  c.structure = *parsed;
+  const std::string loop = root.object.string("loop");
+  if (loop != "velocity" && loop != "position")
+    root.fail("loop", "expected \"velocity\" or \"position\", got \"" + loop + "\"");
+  if (loop != loop_name(c.structure))
+    root.fail("loop", "a \"" + structure + "\" controller closes the " + loop_name(c.structure) + " loop, got \"" +
+                          loop + "\"");
+  root.expect_string("feedback", "motor");
+
+  c.plant = read_plant(root.section("plant"), out.plant_source);
+  const Section gains = root.section("gains");
+  const GainsRead physical = read_gains(gains, c.structure);
+  const GainsRead normalized = read_gains(root.section("normalized"), c.structure);
+  check_gains_agree(gains, physical, normalized, c.plant);
+  c.physical = physical.gains;
+  c.normalized = normalized.gains;
+  c.kpp_physical = physical.kpp;
+  c.kpp_normalized = normalized.kpp;
+
+  read_state_space(root, c.physical, c.plant.omega_z);
+  c.discrete = read_discrete(root, c.physical, c.prewarp_rad_s);
+  c.design = read_design(root.section("design"), c.plant.omega_z);
+  c.predicted = read_predicted(root.section("predicted"), c.plant.omega_z);
+  c.robustness = read_robustness(root.section("robustness"));
+  c.position = read_position(root, c.structure, c.plant.omega_z);
+  c.notes = read_notes(root);
+  return out;
+}
+
+LoadedController load_controller(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError({path, 0, 0, ""}, "cannot open the controller file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_controller_json(text.str(), path);
+}
+
+}  // namespace servotwin::io

@@ -1,0 +1,72 @@
+#include "servotwin/tuning/controller.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "servotwin/core/error.hpp"
+
+namespace servotwin::tuning {
+
+std::string to_string(Structure structure) {
+  switch (structure) {
+    case Structure::kPi:
+      return "pi";
+    case Structure::kPid:
+      return "pid";
+    case Structure::kPiP:
+      return "pi+p";
+  }
+  return "pi";
+}
+
+std::optional<Structure> structure_from_string(const std::string& name) {
+  for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP}) {
+    if (to_string(s) == name) return s;
+  }
+  return std::nullopt;
+}
+
+core::StateSpace controller_state_space(const PidGains& g) {
+  core::StateSpace sys;
+  if (g.kd == 0.0) {
+    // One integrator state xi' = ω* − ωm; u = ki xi + wp kp ω* − kp ωm.
+    sys.A = Eigen::MatrixXd::Zero(1, 1);
+    sys.B.resize(1, 2);
+    sys.B << 1.0, -1.0;
+    sys.C.resize(1, 1);
+    sys.C << g.ki;
+    sys.D.resize(1, 2);
+    sys.D << g.wp * g.kp, -g.kp;
+    return sys;
+  }
+  if (!(g.tau > 0.0)) throw std::invalid_argument("controller_state_space: a derivative needs tau > 0");
+  // Filtered derivative of v = wd ω* − ωm: kd s/(τs + 1) v = (kd/τ)(v − xd), xd' = (v − xd)/τ.
+  const double k = g.kd / g.tau;
+  sys.A.resize(2, 2);
+  sys.A << 0.0, 0.0, 0.0, -1.0 / g.tau;
+  sys.B.resize(2, 2);
+  sys.B << 1.0, -1.0, g.wd / g.tau, -1.0 / g.tau;
+  sys.C.resize(1, 2);
+  sys.C << g.ki, -k;
+  sys.D.resize(1, 2);
+  sys.D << g.wp * g.kp + g.wd * k, -g.kp - k;
+  return sys;
+}
+
+core::DiscreteStateSpace discretize_controller(const PidGains& physical, double ts, std::optional<double> prewarp_rad_s) {
+  if (!std::isfinite(ts) || ts <= 0.0) {
+    throw core::InputError(core::at_field("ts"), "expected a sample period > 0 s, got " + std::to_string(ts));
+  }
+  const double nyquist = std::numbers::pi / ts;
+  if (prewarp_rad_s && (!std::isfinite(*prewarp_rad_s) || *prewarp_rad_s <= 0.0 || *prewarp_rad_s >= nyquist)) {
+    throw core::InputError(core::at_field("ts"),
+                           "the prewarp frequency " + std::to_string(*prewarp_rad_s / (2.0 * std::numbers::pi)) +
+                               " Hz must lie below the Nyquist frequency " +
+                               std::to_string(nyquist / (2.0 * std::numbers::pi)) + " Hz: shorten the sample period");
+  }
+  return core::discretize_tustin(controller_state_space(physical), ts, prewarp_rad_s);
+}
+
+}  // namespace servotwin::tuning

@@ -1,0 +1,315 @@
+#include "servotwin/tuning/tune.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <limits>
+#include <numbers>
+
+#include "servotwin/core/error.hpp"
+#include "servotwin/core/norms.hpp"
+#include "servotwin/tuning/position_loop.hpp"
+#include "servotwin/tuning/uncertainty.hpp"
+
+namespace servotwin::tuning {
+
+namespace {
+
+using core::InputError;
+using core::at_field;
+
+constexpr double kRatioForPassiveMethods = 1.3;  // C7.4: below it no PI/PID reaches a useful bandwidth
+
+void require(bool ok, const char* flag, const std::string& message) {
+  if (!ok) throw InputError(at_field(flag), message);
+}
+
+void validate(const TuneOptions& o) {
+  require(std::isfinite(o.zeta_star) && o.zeta_star > 0.0 && o.zeta_star <= 3.0, "--zeta-star",
+          fmt::format("expected a damping in (0, 3], got {}", o.zeta_star));
+  if (o.omega_star) {
+    require(std::isfinite(*o.omega_star) && *o.omega_star > 0.0, "--omega-star",
+            fmt::format("expected omega*/omega_z > 0, got {}", *o.omega_star));
+  }
+  require(std::isfinite(o.target_r) && o.target_r > 1.0, "--target-r",
+          fmt::format("expected a resonance ratio > 1, got {}", o.target_r));
+  if (o.tau) require(std::isfinite(*o.tau) && *o.tau > 0.0, "--tau", fmt::format("expected a time > 0 s, got {}", *o.tau));
+  require(std::isfinite(o.ms) && o.ms > 1.0, "--ms", fmt::format("expected a sensitivity peak limit > 1, got {}", o.ms));
+  require(std::isfinite(o.mt) && o.mt >= 1.0, "--mt", fmt::format("expected a tracking peak limit >= 1, got {}", o.mt));
+  if (o.ts) require(std::isfinite(*o.ts) && *o.ts > 0.0, "--ts", fmt::format("expected a sample period > 0 s, got {}", *o.ts));
+  require(o.setpoint_weight >= 0.0 && o.setpoint_weight <= 1.0, "--setpoint-weight",
+          fmt::format("expected a weight in [0, 1], got {}", o.setpoint_weight));
+  require(o.scan_points >= 4 && o.scan_points <= 1000, "scan_points", "expected 4 to 1000 candidates");
+  if (o.w2) {
+    require(o.w2->is_proper(), "--w2", "the uncertainty weight must be proper (numerator degree <= denominator degree)");
+    require(core::is_hurwitz(o.w2->den()), "--w2", "the uncertainty weight must be stable (poles in the left half-plane)");
+  }
+}
+
+/// The frequency grid of the scan: wide enough for every loop function of a normalized plant.
+std::vector<double> scan_grid(const NormalizedPlant& plant) {
+  std::vector<double> g = core::log_space(1e-3, 100.0 * std::max(plant.r, 1.0), 500);
+  // The lightly damped mode: put its exact frequencies on the grid so its peak is not stepped over.
+  g.push_back(1.0);
+  g.push_back(plant.r);
+  std::sort(g.begin(), g.end());
+  g.erase(std::unique(g.begin(), g.end()), g.end());
+  return g;
+}
+
+/// The design at one ω*: the PI of C7.3 or the virtual-inertia PID of C7.5, with the setpoint weight.
+struct GainDesigner {
+  const NormalizedPlant& plant;
+  const TuneOptions& options;
+  double omega_z;
+
+  [[nodiscard]] double tau_normalized(double omega_star) const {
+    return options.tau ? *options.tau * omega_z : default_derivative_time_constant(plant.r, omega_star);
+  }
+
+  [[nodiscard]] PidGains operator()(double omega_star, std::vector<std::string>* warnings = nullptr) const {
+    PidGains g;
+    if (options.structure == Structure::kPid) {
+      const PidDesign d = pid_design(plant, options.target_r, omega_star, options.zeta_star,
+                                     tau_normalized(omega_star), options.allow_negative_kd);
+      g = d.gains;
+      if (warnings) warnings->insert(warnings->end(), d.warnings.begin(), d.warnings.end());
+    } else {
+      const PiGains pi = pi_pole_placement(plant.motor(false), omega_star, options.zeta_star).gains;
+      g.kp = pi.kp;
+      g.ki = pi.ki;
+    }
+    g.wp = options.setpoint_weight;
+    return g;
+  }
+};
+
+/// A coarser robustness grid for the ω* scan (the chosen design is re-evaluated on the full one).
+RobustnessOptions scan_robustness_options() {
+  RobustnessOptions o;
+  o.grid_points = 250;
+  o.rel_tol = 1e-4;
+  return o;
+}
+
+/// The spec evaluated on the loop WITH the HF dynamics: stability, ‖S‖∞, the tracking peak, the
+/// bandwidth, and robust performance (uncertainty.hpp) when W2 is given.
+struct SpecCheck {
+  const NormalizedPlant& plant;
+  const TuneOptions& options;
+  std::optional<core::TransferFunction> w2;  // normalized time
+  std::vector<double> grid;
+
+  [[nodiscard]] TuneResult::Candidate operator()(double omega_star, const PidGains& gains) const {
+    TuneResult::Candidate c;
+    c.omega_star = omega_star;
+    const VelocityLoop loop(plant, gains);
+    c.stable = loop.stable();
+    if (!c.stable) return c;
+    c.peak_s = core::peak_on_grid([&](double w) { return loop.sensitivity(w); }, grid, 1e-4).value;
+    const bool load = loop.has_load();
+    const auto tracking = [&](double w) { return load ? loop.load_tracking(w) : loop.motor_tracking(w); };
+    c.peak_tracking = core::peak_on_grid(tracking, grid, 1e-4).value;
+    std::vector<double> bw_grid{0.0};
+    bw_grid.insert(bw_grid.end(), grid.begin(), grid.end());
+    c.bandwidth = core::bandwidth(tracking, bw_grid).value_or(0.0);
+    c.feasible = c.peak_s <= options.ms && c.peak_tracking <= options.mt;
+    if (c.feasible && w2) c.feasible = robustness(loop, *w2, options.ms, scan_robustness_options()).rp_ok;
+    return c;
+  }
+};
+
+[[nodiscard]] std::vector<double> candidates(const AdmissibleRange& range, std::size_t n) {
+  const double hi = range.omega_max;
+  const double lo = std::max(range.omega_min, 0.02 * hi);
+  std::vector<double> c = core::log_space(lo * (1.0 + 1e-9), hi * (1.0 - 1e-9), n);
+  return c;
+}
+
+/// The largest-bandwidth feasible candidate, its boundary with the next infeasible one refined
+/// by bisection (feasibility usually ends at a peak limit reached as ω* grows).
+TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, const GainDesigner& design,
+                             const SpecCheck& check) {
+  std::size_t best = scan.size();
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    if (scan[i].feasible && (best == scan.size() || scan[i].bandwidth > scan[best].bandwidth)) best = i;
+  }
+  if (best == scan.size()) return {};
+  TuneResult::Candidate chosen = scan[best];
+  if (best + 1 < scan.size() && !scan[best + 1].feasible) {
+    double lo = scan[best].omega_star, hi = scan[best + 1].omega_star;
+    for (int it = 0; it < 12; ++it) {
+      const double mid = std::sqrt(lo * hi);
+      const TuneResult::Candidate c = check(mid, design(mid));
+      if (c.feasible) {
+        lo = mid;
+        if (c.bandwidth > chosen.bandwidth) chosen = c;
+      } else {
+        hi = mid;
+      }
+    }
+  }
+  return chosen;
+}
+
+[[noreturn]] void no_feasible_omega(const std::vector<TuneResult::Candidate>& scan, const TuneOptions& o) {
+  double best_s = std::numeric_limits<double>::infinity(), best_t = best_s, at = 0.0;
+  for (const TuneResult::Candidate& c : scan) {
+    if (c.stable && std::max(c.peak_s / o.ms, c.peak_tracking / o.mt) < std::max(best_s / o.ms, best_t / o.mt)) {
+      best_s = c.peak_s;
+      best_t = c.peak_tracking;
+      at = c.omega_star;
+    }
+  }
+  if (!std::isfinite(best_s)) {
+    throw InputError(at_field("--structure"),
+                     "no omega* in the admissible range gives a stable loop with the known HF dynamics: "
+                     "reduce the delay/lags or use a slower structure");
+  }
+  throw InputError(at_field(o.w2 ? "--w2" : "--ms"),
+                   fmt::format("no omega* meets ||S|| <= {} and the tracking peak <= {}{}: the best achievable are "
+                               "||S|| = {:.3g} and {:.3g} at omega*/omega_z = {:.3g}; relax --ms/--mt",
+                               o.ms, o.mt, o.w2 ? " with robust performance" : "", best_s, best_t, at));
+}
+
+PlantScales scales(const NormalizedPlant& p) { return {p.omega_z, p.motor_inertia, p.r, p.zeta_z, p.zeta_p, p.a}; }
+
+/// Prewarp the Tustin map at the closed-loop bandwidth when it lies safely below Nyquist.
+std::optional<double> prewarp_frequency(const Controller& c, double ts) {
+  const double w = c.predicted.bandwidth_motor * c.plant.omega_z;
+  if (std::isfinite(w) && w > 0.0 && w < 0.5 * std::numbers::pi / ts) return w;
+  return std::nullopt;
+}
+
+void add_discrete(Controller& c, double ts) {
+  c.prewarp_rad_s = prewarp_frequency(c, ts);
+  c.discrete = discretize_controller(c.physical, ts, c.prewarp_rad_s);
+  if (c.physical.kd != 0.0 && ts / c.physical.tau > 0.5) {
+    c.notes.push_back(fmt::format("the derivative filter tau = {:.3g} s is short against ts = {:.3g} s: "
+                                  "its discrete pole is poorly resolved; increase --tau",
+                                  c.physical.tau, ts));
+  }
+  const double w_bw = c.predicted.bandwidth_motor * c.plant.omega_z;
+  if (w_bw * ts > 0.1) {
+    c.notes.push_back(fmt::format("the loop bandwidth is {:.0f} % of the sampling rate: the discrete loop "
+                                  "loses phase; verify with the sample delay in the HF dynamics (--delay)",
+                                  100.0 * w_bw * ts / (2.0 * std::numbers::pi)));
+  }
+}
+
+/// The P position loop over the tuned velocity loop (C7.10): the largest gain without overshoot
+/// of the load position, lowered to the robust limits when W2 is given.
+void add_position_loop(Controller& c, const VelocityLoop& loop, const std::optional<core::TransferFunction>& w2,
+                       const NormalizedPlant& plant) {
+  // With higher modes the load side is that of the first mode's two-mass realization.
+  const VelocityLoop first_mode(plant, c.normalized, true, false);
+  if (!first_mode.has_load()) {
+    throw InputError(at_field("--structure"),
+                     "pi+p needs the load side of a two-mass realization, and this plant has none (its friction "
+                     "terms would be negative); tune the velocity loop with --structure pi");
+  }
+  if (!plant.higher_modes.empty()) {
+    c.notes.push_back("the position loop is designed on the first mode's two-mass realization (higher modes left out)");
+  }
+  const PositionLoop position(functions_of(loop.has_load() ? loop : first_mode), w2);
+  const PositionLoopDesign d = position.design();
+  if (!(d.kpp_nominal > 0.0)) {
+    throw InputError(at_field("--structure"), "no position gain keeps the load position free of overshoot");
+  }
+  PositionSummary p;
+  p.kpp_nominal = d.kpp_nominal;
+  double kpp = d.kpp_nominal;
+  if (w2) {
+    p.kpp_rs = d.kpp_rs;
+    p.kpp_rp_exact = d.kpp_rp_exact;
+    kpp = std::min({kpp, d.kpp_rs, d.kpp_rp_exact});
+    if (!(kpp > 0.0)) {
+      throw InputError(at_field("--w2"), "no position gain is robustly stable/robustly performing for this W2");
+    }
+    if (kpp < d.kpp_nominal) c.notes.push_back("position gain lowered below the no-overshoot value by the uncertainty W2");
+  }
+  p.bandwidth_load = position.load_bandwidth(kpp).value_or(0.0);
+  p.j2 = position.load_disturbance_peak(kpp);
+  p.peak_load_tracking = position.load_tracking_peak(kpp);
+  c.kpp_normalized = kpp;
+  c.kpp_physical = kpp * plant.omega_z;
+  c.position = p;
+}
+
+}  // namespace
+
+TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
+  validate(options);
+  TuneResult result;
+  result.plant = normalize(model, options.hf);
+  const NormalizedPlant& plant = result.plant;
+  result.advice = advise(plant.r, options.zeta_star);
+  if (plant.r < kRatioForPassiveMethods) {
+    throw InputError(at_field("plant"),
+                     fmt::format("resonance ratio r = {:.3f} < {}: a PI/PID cannot damp this mode (catalog C7.4); "
+                                 "recommend passive methods: a notch filter or an input shaper (servotwin shaper)",
+                                 plant.r, kRatioForPassiveMethods));
+  }
+  const GainDesigner design{plant, options, plant.omega_z};
+  const double kd = options.structure == Structure::kPid ? virtual_inertia_kd(plant.r, options.target_r) : 0.0;
+  result.range = admissible_range(plant, options.zeta_star, kd);
+  if (result.range.empty()) {
+    throw InputError(at_field("--zeta-star"),
+                     fmt::format("no admissible omega* for zeta* = {} on r = {:.3f} (the second pole pair is "
+                                 "slower than the assigned one everywhere); lower --zeta-star",
+                                 options.zeta_star, plant.r));
+  }
+  std::optional<core::TransferFunction> w2_normalized;
+  if (options.w2) w2_normalized = to_normalized_time(*options.w2, plant.omega_z);
+  const SpecCheck check{plant, options, w2_normalized, scan_grid(plant)};
+  Controller& c = result.controller;
+  c.structure = options.structure;
+  c.plant = scales(plant);
+  c.design.zeta_star = options.zeta_star;
+  c.design.ms = options.ms;
+  c.design.mt = options.mt;
+  if (options.structure == Structure::kPid) c.design.r_target = options.target_r;
+
+  if (options.omega_star) {
+    const double w = *options.omega_star;
+    if (w < result.range.omega_min || w > result.range.omega_max) {
+      throw InputError(at_field("--omega-star"),
+                       fmt::format("omega*/omega_z = {} lies outside the admissible range [{:.4g}, {:.4g}] "
+                                   "(upper end: {}); choose inside it or use --omega-star auto",
+                                   w, result.range.omega_min, result.range.omega_max, to_string(result.range.upper)));
+    }
+    c.design.omega_star = w;
+    c.design.omega_star_source = "given";
+  } else {
+    for (double w : candidates(result.range, options.scan_points)) result.scan.push_back(check(w, design(w)));
+    const TuneResult::Candidate chosen = choose(result.scan, design, check);
+    if (!chosen.feasible) no_feasible_omega(result.scan, options);
+    c.design.omega_star = chosen.omega_star;
+    c.design.omega_star_source = options.w2 ? "largest load bandwidth with ||S|| <= Ms, peak <= Mt and robust performance"
+                                            : "largest load bandwidth with ||S|| <= Ms and peak <= Mt";
+  }
+  c.normalized = design(c.design.omega_star, &c.notes);
+  c.physical = to_physical(c.normalized, plant);
+  const VelocityLoop loop(plant, c.normalized);
+  c.predicted = analyse(plant, c.normalized);
+  if (!c.predicted.closed_loop_stable) {
+    c.notes.push_back("the loop with the known HF dynamics is UNSTABLE at this omega*: choose a smaller one");
+  }
+  if (check.w2) {
+    const RobustnessResult rob = robustness(loop, *check.w2, options.ms);
+    c.robustness.rs = rob.rs;
+    c.robustness.np = rob.np;
+    c.robustness.rp = rob.rp;
+    if (!rob.rs_ok) c.notes.push_back("robust stability FAILS for the given W2 (||W2 T|| >= 1)");
+  }
+  if (options.structure == Structure::kPiP) add_position_loop(c, loop, check.w2, plant);
+  if (!result.advice.verdict.empty()) c.notes.push_back(result.advice.verdict);
+  if (!plant.higher_modes.empty()) {
+    c.notes.push_back(fmt::format("designed on the first mode; {} higher mode(s) are included in every index",
+                                  plant.higher_modes.size()));
+  }
+  if (options.ts) add_discrete(c, *options.ts);
+  return result;
+}
+
+}  // namespace servotwin::tuning

@@ -1,0 +1,264 @@
+#include "servotwin/tuning/velocity_loop.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace servotwin::tuning {
+
+using core::Polynomial;
+using core::TransferFunction;
+using Complex = std::complex<double>;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+void check_gains(const PidGains& g) {
+  for (double v : {g.kp, g.ki, g.kd, g.tau, g.wp, g.wd}) {
+    if (!std::isfinite(v)) throw std::invalid_argument("pid_controller: gains must be finite");
+  }
+  if (g.tau < 0.0) throw std::invalid_argument("pid_controller: tau must be >= 0");
+  if (g.kd != 0.0 && g.tau == 0.0) {
+    throw std::invalid_argument("pid_controller: an ideal derivative (kd != 0, tau = 0) is improper");
+  }
+}
+
+/// The plant without higher modes when they are not wanted, so the two-mass realization exists.
+NormalizedPlant design_plant(const NormalizedPlant& plant, bool with_higher_modes) {
+  NormalizedPlant p = plant;
+  if (!with_higher_modes) p.higher_modes.clear();
+  return p;
+}
+
+}  // namespace
+
+ControllerTf pid_controller(const PidGains& g) {
+  check_gains(g);
+  if (g.kd == 0.0) {
+    // Without integral action there is no pole at 0: keep the controller a constant so the loop
+    // polynomial does not carry a spurious root at s = 0.
+    if (g.ki == 0.0) return {TransferFunction(Polynomial{g.kp}, Polynomial{1.0}),
+                             TransferFunction(Polynomial{g.wp * g.kp}, Polynomial{1.0})};
+    return {TransferFunction(Polynomial{g.kp, g.ki}, Polynomial{1.0, 0.0}),
+            TransferFunction(Polynomial{g.wp * g.kp, g.ki}, Polynomial{1.0, 0.0})};
+  }
+  // C = kp + ki/s + kd s/(τs + 1) over the common denominator s(τs + 1).
+  if (g.ki == 0.0) {
+    return {TransferFunction(Polynomial{g.kp * g.tau + g.kd, g.kp}, Polynomial{g.tau, 1.0}),
+            TransferFunction(Polynomial{g.wp * g.kp * g.tau + g.wd * g.kd, g.wp * g.kp}, Polynomial{g.tau, 1.0})};
+  }
+  const Polynomial den{g.tau, 1.0, 0.0};
+  return {TransferFunction(Polynomial{g.kp * g.tau + g.kd, g.kp + g.ki * g.tau, g.ki}, den),
+          TransferFunction(Polynomial{g.wp * g.kp * g.tau + g.wd * g.kd, g.wp * g.kp + g.ki * g.tau, g.ki}, den)};
+}
+
+std::optional<TwoMassTransfer> two_mass_transfer(const NormalizedPlant& plant) {
+  const std::optional<FrictionTwoMass> m = physical_parameters_with_friction(plant);
+  if (!m) return std::nullopt;
+  // Every function over the monic (s + a)(s² + 2ζp r s + r²) = D'/Il (plan §1.1 realization).
+  const TransferFunction motor = plant.motor(false);
+  const Polynomial& den = motor.den();
+  const double k = m->stiffness;
+  const double il = m->load_inertia;
+  const Polynomial coupling{m->damping / il, k / il};  // c/Il
+  return TwoMassTransfer{motor, TransferFunction(coupling, den), TransferFunction(-1.0 * coupling, den),
+                         TransferFunction(Polynomial{-1.0 / il, -(m->motor_viscous + m->damping) / il, -k / il}, den)};
+}
+
+TransferFunction pade_delay(double delay, int order) {
+  if (!std::isfinite(delay) || delay < 0.0) throw std::invalid_argument("pade_delay: delay must be finite and >= 0");
+  if (order < 1 || order > 10) throw std::invalid_argument("pade_delay: order must lie in [1, 10]");
+  if (delay == 0.0) return {Polynomial{1.0}, Polynomial{1.0}};
+  // e^{-x} ≈ Σ c_k (−x)^k / Σ c_k x^k with c_k = (2N − k)! N! / ((2N)! k! (N − k)!), x = sT.
+  const auto n = static_cast<std::size_t>(order);
+  std::vector<double> c(n + 1);
+  c[0] = 1.0;
+  for (std::size_t k = 1; k <= n; ++k) {
+    c[k] = c[k - 1] * static_cast<double>(n - k + 1) / (static_cast<double>(k) * static_cast<double>(2 * n - k + 1));
+  }
+  std::vector<double> num(n + 1), den(n + 1);  // descending powers of s
+  for (std::size_t k = 0; k <= n; ++k) {
+    const double term = c[k] * std::pow(delay, static_cast<double>(k));
+    den[n - k] = term;
+    num[n - k] = (k % 2 == 0) ? term : -term;
+  }
+  return {Polynomial(num), Polynomial(den)};
+}
+
+struct VelocityLoop::Values {
+  Complex nc, dc, nr, na, da, nf, df, np, dp, delta;
+};
+
+VelocityLoop::VelocityLoop(const NormalizedPlant& plant, const PidGains& gains, bool with_hf, bool with_higher_modes,
+                           int pade_order)
+    : gains_(gains), controller_(pid_controller(gains)), pade_order_(pade_order), r_(plant.r) {
+  if (!(plant.r > 1.0) || !std::isfinite(plant.r)) {
+    throw std::invalid_argument("VelocityLoop: the plant's resonance ratio must be > 1 (use normalize())");
+  }
+  const NormalizedPlant p = design_plant(plant, with_higher_modes);
+  const TransferFunction motor = p.motor(true);
+  plant_num_ = motor.num();
+  plant_den_ = motor.den();
+  if (with_hf) {
+    validate(p.hf);
+    const TransferFunction act = p.hf.actuator_rational();
+    const TransferFunction fb = p.hf.feedback_rational();
+    act_num_ = act.num();
+    act_den_ = act.den();
+    fb_num_ = fb.num();
+    fb_den_ = fb.den();
+    delay_ = p.hf.delay_s.value_or(0.0);
+  }
+  if (const std::optional<FrictionTwoMass> m = p.higher_modes.empty() ? physical_parameters_with_friction(p)
+                                                                        : std::nullopt) {
+    const std::optional<TwoMassTransfer> tm = two_mass_transfer(p);
+    has_load_ = tm.has_value();
+    if (tm) {
+      load_num_ = tm->load_from_torque.num();
+      motor_dist_num_ = tm->motor_from_load_torque.num();
+      load_dist_num_ = tm->load_from_load_torque.num();
+      load_inertia_ = m->load_inertia;
+    }
+  }
+  const TransferFunction pade = pade_delay(delay_, pade_order_);
+  characteristic_ = rational(pade.num(), pade.den()).characteristic;
+}
+
+VelocityLoop::Values VelocityLoop::values(double omega) const noexcept {
+  const Complex s(0.0, omega);
+  Values v;
+  v.nc = controller_.feedback.num()(s);
+  v.dc = controller_.feedback.den()(s);
+  v.nr = controller_.reference.num()(s);
+  v.na = act_num_(s) * std::polar(1.0, -omega * delay_);
+  v.da = act_den_(s);
+  v.nf = fb_num_(s);
+  v.df = fb_den_(s);
+  v.np = plant_num_(s);
+  v.dp = plant_den_(s);
+  v.delta = v.dc * v.da * v.df * v.dp + v.nc * v.na * v.nf * v.np;
+  return v;
+}
+
+Complex VelocityLoop::controller(double omega) const noexcept {
+  return controller_.feedback.frequency_response(omega);
+}
+
+Complex VelocityLoop::plant(double omega) const noexcept {
+  const Complex s(0.0, omega);
+  return plant_num_(s) / plant_den_(s);
+}
+
+Complex VelocityLoop::loop_gain(double omega) const noexcept {
+  const Values v = values(omega);
+  return (v.nc * v.na * v.nf * v.np) / (v.dc * v.da * v.df * v.dp);
+}
+
+Complex VelocityLoop::sensitivity(double omega) const noexcept {
+  const Values v = values(omega);
+  return v.dc * v.da * v.df * v.dp / v.delta;
+}
+
+Complex VelocityLoop::complementary(double omega) const noexcept {
+  const Values v = values(omega);
+  return v.nc * v.na * v.nf * v.np / v.delta;
+}
+
+Complex VelocityLoop::motor_tracking(double omega) const noexcept {
+  const Values v = values(omega);
+  return v.nr * v.na * v.df * v.np / v.delta;
+}
+
+Complex VelocityLoop::effort(double omega) const noexcept {
+  const Values v = values(omega);
+  return v.nr * v.da * v.df * v.dp / v.delta;
+}
+
+Complex VelocityLoop::load_tracking(double omega) const noexcept {
+  if (!has_load_) return {kNaN, kNaN};
+  const Values v = values(omega);
+  return v.nr * v.na * v.df * load_num_(Complex(0.0, omega)) / v.delta;
+}
+
+Complex VelocityLoop::motor_from_load_torque(double omega) const noexcept {
+  if (!has_load_) return {kNaN, kNaN};
+  const Values v = values(omega);
+  return motor_dist_num_(Complex(0.0, omega)) * v.dc * v.da * v.df / v.delta;
+}
+
+Complex VelocityLoop::load_from_load_torque(double omega) const noexcept {
+  if (!has_load_) return {kNaN, kNaN};
+  // ωl/Tl = Gll − Glm·A·C·F·Gml·S; with the two-mass identity nLl·nP − nLm·nMl = −s·dP/Il the dP
+  // cancels exactly, which keeps the value finite at ω = 0 for an integrating plant.
+  const Values v = values(omega);
+  const Complex s(0.0, omega);
+  return (load_dist_num_(s) * v.dc * v.da * v.df - s * v.nc * v.na * v.nf / load_inertia_) / v.delta;
+}
+
+Complex VelocityLoop::open_loop_load_from_load_torque(double omega) const noexcept {
+  if (!has_load_) return {kNaN, kNaN};
+  const Complex s(0.0, omega);
+  return load_dist_num_(s) / plant_den_(s);
+}
+
+VelocityLoop::Responses VelocityLoop::responses(double omega) const noexcept {
+  const Values v = values(omega);
+  const Complex s(0.0, omega);
+  const Complex open = v.nc * v.na * v.nf * v.np;
+  const Complex plant_side = v.dc * v.da * v.df * v.dp;
+  Responses r;
+  r.loop_gain = open / plant_side;
+  r.sensitivity = plant_side / v.delta;
+  r.complementary = open / v.delta;
+  r.motor_tracking = v.nr * v.na * v.df * v.np / v.delta;
+  r.effort = v.nr * v.da * v.df * v.dp / v.delta;
+  if (!has_load_) {
+    r.load_tracking = r.motor_from_load_torque = r.load_from_load_torque = r.open_loop_load_from_load_torque = {kNaN, kNaN};
+    return r;
+  }
+  const Complex load_dist = load_dist_num_(s);
+  r.load_tracking = v.nr * v.na * v.df * load_num_(s) / v.delta;
+  r.motor_from_load_torque = motor_dist_num_(s) * v.dc * v.da * v.df / v.delta;
+  r.load_from_load_torque = (load_dist * v.dc * v.da * v.df - s * v.nc * v.na * v.nf / load_inertia_) / v.delta;
+  r.open_loop_load_from_load_torque = load_dist / v.dp;
+  return r;
+}
+
+ClosedLoopTransfer VelocityLoop::rational(const Polynomial& delay_num, const Polynomial& delay_den) const {
+  const Polynomial& nc = controller_.feedback.num();
+  const Polynomial& dc = controller_.feedback.den();
+  const Polynomial& nr = controller_.reference.num();
+  const Polynomial na = act_num_ * delay_num;
+  const Polynomial da = act_den_ * delay_den;
+  const Polynomial open_den = dc * da * fb_den_ * plant_den_;
+  const Polynomial open_num = nc * na * fb_num_ * plant_num_;
+  const Polynomial delta = open_den + open_num;
+  ClosedLoopTransfer cl{delta,
+                        TransferFunction(open_den, delta),
+                        TransferFunction(open_num, delta),
+                        TransferFunction(nr * na * fb_den_ * plant_num_, delta),
+                        TransferFunction(nr * da * fb_den_ * plant_den_, delta),
+                        std::nullopt,
+                        std::nullopt,
+                        std::nullopt,
+                        std::nullopt};
+  if (has_load_) {
+    cl.load_tracking = TransferFunction(nr * na * fb_den_ * load_num_, delta);
+    cl.motor_from_load_torque = TransferFunction(motor_dist_num_ * dc * da * fb_den_, delta);
+    cl.load_from_load_torque = TransferFunction(
+        load_dist_num_ * dc * da * fb_den_ - (1.0 / load_inertia_) * (Polynomial{1.0, 0.0} * nc * na * fb_num_), delta);
+    cl.effort_from_load_torque = TransferFunction(-1.0 * (nc * fb_num_ * motor_dist_num_ * da), delta);
+  }
+  return cl;
+}
+
+ClosedLoopTransfer VelocityLoop::closed_loop() const {
+  const TransferFunction pade = pade_delay(delay_, pade_order_);
+  return rational(pade.num(), pade.den());
+}
+
+bool VelocityLoop::stable() const { return core::is_hurwitz(characteristic_); }
+
+}  // namespace servotwin::tuning
