@@ -43,4 +43,15 @@ void require_pair(double omega_star, double zeta_star) {
   require_positive(zeta_star, "zeta_star", "a damping ratio");
 }
 
+void require_grid(double omega_min, double omega_max, std::size_t grid_points, double rel_tol, const std::string& prefix) {
+  require_positive(omega_min, prefix + "omega_min", "a grid start");
+  require_positive(omega_max, prefix + "omega_max", "a grid end");
+  if (!(omega_max > omega_min))
+    throw core::InputError(core::at_field(prefix + "omega_max"), "expected omega_max > omega_min, got " + show(omega_max));
+  if (grid_points < 2 || grid_points > 1000000)
+    throw core::InputError(core::at_field(prefix + "grid_points"), "expected 2 .. 1e6 grid points");
+  if (!(rel_tol >= 1e-12 && rel_tol <= 0.1))
+    throw core::InputError(core::at_field(prefix + "rel_tol"), "expected a tolerance in [1e-12, 0.1], got " + show(rel_tol));
+}
+
 }  // namespace servotwin::tuning::detail

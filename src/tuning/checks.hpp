@@ -1,6 +1,7 @@
 #pragma once
 // Argument checks shared by the tuning sources: each throws core::InputError naming the parameter.
 #include <complex>
+#include <cstddef>
 #include <string>
 
 namespace servotwin::tuning::detail {
@@ -20,5 +21,9 @@ void require_finite(double value, const std::string& field);
 void require_ratio(double r, const std::string& field);
 /// ω* > 0 and ζ* > 0, both finite.
 void require_pair(double omega_star, double zeta_star);
+/// A frequency grid's settings as the analyses take them (fields named under `prefix`, e.g.
+/// "options."): 0 < omega_min < omega_max, 2 .. 1e6 points, rel_tol in [1e-12, 0.1].
+void require_grid(double omega_min, double omega_max, std::size_t grid_points, double rel_tol,
+                  const std::string& prefix);
 
 }  // namespace servotwin::tuning::detail

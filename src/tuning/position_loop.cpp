@@ -27,14 +27,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPeakSlack = 1e-9;
 
 void check_options(const PositionLoopOptions& o) {
-  detail::require_positive(o.omega_min, "options.omega_min", "a grid start");
-  detail::require_positive(o.omega_max, "options.omega_max", "a grid end");
-  if (!(o.omega_max > o.omega_min))
-    throw InputError(core::at_field("options.omega_max"), "expected omega_max > omega_min, got " + show(o.omega_max));
-  if (o.grid_points < 2 || o.grid_points > 1000000)
-    throw InputError(core::at_field("options.grid_points"), "expected 2 .. 1e6 grid points");
-  if (!(o.rel_tol >= 1e-12 && o.rel_tol <= 0.1))
-    throw InputError(core::at_field("options.rel_tol"), "expected a tolerance in [1e-12, 0.1], got " + show(o.rel_tol));
+  detail::require_grid(o.omega_min, o.omega_max, o.grid_points, o.rel_tol, "options.");
   detail::require_positive(o.peak_limit, "options.peak_limit", "a peak limit");
   detail::require_positive(o.kpp_min, "options.kpp_min", "a smallest gain");
   detail::require_positive(o.kpp_max, "options.kpp_max", "a largest gain");

@@ -5,26 +5,13 @@
 #include <numbers>
 
 #include "cli_support.hpp"
+#include "e10_frf.hpp"
 #include "servotwin/core/transfer_function.hpp"
 #include "servotwin/io/frf_csv.hpp"
 #include "servotwin/io/plant_model_json.hpp"
 
 namespace servotwin::cli_test {
 namespace {
-
-std::string e10_csv(std::size_t count) {
-  const core::TransferFunction tf(core::Polynomial{0.5, 0.06, 0.5}, core::Polynomial{1.0, 1.1, 9.18, 1.8});
-  core::FrequencyResponse r;
-  for (double w : core::log_space(0.05, 15.0, count)) {
-    core::FrequencyPoint p;
-    p.freq_hz = w / (2.0 * std::numbers::pi);
-    p.value = tf.frequency_response(w);
-    r.points.push_back(p);
-  }
-  std::ostringstream out;
-  io::write_frf_csv(out, r);
-  return out.str();
-}
 
 TEST_F(Cli, FitWritesThePlantModelAndPrintsTheSummary) {
   write("frf.csv", e10_csv(20));

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "cli_support.hpp"
+#include "e10_frf.hpp"
 #include "servotwin/core/transfer_function.hpp"
 #include "servotwin/io/controller_json.hpp"
 #include "servotwin/io/frf_csv.hpp"
@@ -36,24 +37,8 @@ TEST_F(Cli, TuneReproducesE26AndWritesTheController) {
   EXPECT_EQ(run("tune e26.json -o controller.json").status, 3);
 }
 
-std::string table51_frf() {
-  // E10's table plant (K = 0.5, a = 0.2, ωz = 1, ζz = 0.06, ωn = 3, ζn = 0.15): the `table-5.1`
-  // preset's linear part.
-  const core::TransferFunction tf(core::Polynomial{0.5, 0.06, 0.5}, core::Polynomial{1.0, 1.1, 9.18, 1.8});
-  core::FrequencyResponse resp;
-  for (double w : core::log_space(0.05, 15.0, 40)) {
-    core::FrequencyPoint p;
-    p.freq_hz = w / (2.0 * std::numbers::pi);
-    p.value = tf.frequency_response(w);
-    resp.points.push_back(p);
-  }
-  std::ostringstream out;
-  io::write_frf_csv(out, resp);
-  return out.str();
-}
-
 TEST_F(Cli, TuneGivesTheSameDesignFromAFitAndFromThePreset) {
-  write("frf.csv", table51_frf());
+  write("frf.csv", e10_csv(40));
   ASSERT_EQ(run("fit frf.csv --model two-mass -o pm.json").status, 0);
   ASSERT_EQ(run("tune pm.json --structure pi+p -o fitted.json").status, 0);
   ASSERT_EQ(run("tune table-5.1 --structure pi+p -o preset.json").status, 0);
@@ -86,7 +71,7 @@ TEST_F(Cli, TuneExplainsWhatItCannotDo) {
   r = run("tune e26.json --w2-num 2.6,0");
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("--w2-den"), std::string::npos) << r.err;
-  write("frf.csv", table51_frf());
+  write("frf.csv", e10_csv(40));
   r = run("tune e26.json --w2-from-frf frf.csv");
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("fitted plant model"), std::string::npos) << r.err;
@@ -98,7 +83,7 @@ TEST_F(Cli, TuneExplainsWhatItCannotDo) {
 }
 
 TEST_F(Cli, TuneWithAnUncertaintyWeightFromTheFitResiduals) {
-  write("frf.csv", table51_frf());
+  write("frf.csv", e10_csv(40));
   ASSERT_EQ(run("fit frf.csv --model two-mass -o pm.json").status, 0);
   // A noise-free fit leaves residuals at rounding level: the weight is tiny and robust
   // performance holds at the automatic design.
