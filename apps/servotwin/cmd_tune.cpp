@@ -8,9 +8,11 @@
 #include <string>
 
 #include "command.hpp"
+#include "report_output.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/controller_json.hpp"
 #include "servotwin/io/frf_csv.hpp"
+#include "servotwin/report/tuning_report.hpp"
 #include "servotwin/tuning/tune.hpp"
 #include "servotwin/tuning/uncertainty.hpp"
 #include "tune_input.hpp"
@@ -35,6 +37,7 @@ struct TuneArgs {
   std::optional<double> current_lag, filter, delay, ts;
   double setpoint_weight = 1.0;
   std::string out;
+  std::string report;
 };
 
 std::optional<double> parse_omega_star(const std::string& text) {
@@ -157,6 +160,7 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
 int run(const TuneArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   TunePlant plant = load_tune_plant(a.plant);
+  const auto report_file = open_report(a.report, global);
   const tuning::TuneOptions options = options_from(a, plant);
   auto out = a.out.empty() ? nullptr : open_output(a.out, global);
   tuning::TuneResult result = tuning::tune(plant.model, options);
@@ -166,6 +170,12 @@ int run(const TuneArgs& a, const GlobalOptions& global) {
     out->stream() << io::controller_to_json(result.controller, a.plant).dump(2) << "\n";
     out->commit();
     progress(global, "wrote {} ({:.0f} ms)", a.out, elapsed_ms(start));
+  }
+  if (report_file) {
+    report::TuningReportOptions report_options;
+    report_options.source = a.plant;
+    report_options.w2 = options.w2;
+    write_report(report::tuning_report(result, report_options), *report_file, global);
   }
   return kSuccess;
 }
@@ -209,10 +219,11 @@ void register_tune(CLI::App& app, Action& selected) {
   cmd->add_option("--setpoint-weight", a->setpoint_weight, "Proportional setpoint weight wp in [0, 1] (2-DoF)")
       ->capture_default_str();
   cmd->add_option("-o,--out", a->out, "Write the controller (servotwin.controller/1 JSON; - for stdout)");
+  add_report_option(*cmd, a->report);
   set_examples(*cmd,
                "  servotwin tune plant_model.json -o controller.json\n"
                "  servotwin tune plant_model.json --structure pid --target-r 2 --ts 0.000125 -o pid.json\n"
-               "  servotwin tune table-5.1 --structure pi+p --omega-star 0.4 --zeta-star 1\n"
+               "  servotwin tune table-5.1 --structure pi+p --omega-star 0.4 --zeta-star 1 --report tune.html\n"
                "  servotwin tune plant_model.json --w2-from-frf frf.csv\n"
                "  servotwin tune plant_model.json --delay 0.0005 --w2-num 2.6,0 --w2-den 1,15 --ms 1.6\n");
   cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });

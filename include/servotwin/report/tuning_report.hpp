@@ -1,0 +1,51 @@
+#pragma once
+/// \file
+/// The report of a controller tuning (`servotwin tune --report`, issue-7 plan §3.3): the plant as
+/// the tuner normalized it, the design (ω*, gains, the automatic ω* scan, closed-loop poles), the
+/// loop shapes and margins, the robustness tests against an uncertainty weight W2, the P position
+/// loop of a pi+p design, and the linear step responses of the rational closed loop.
+///
+/// Units: frequencies in Hz (normalized ω × ωz/2π), times in s (normalized t/ωz), gains and
+/// dimensional frequency functions in the plant model's units (torque per velocity for the
+/// controller, velocity per torque for the plant and the load-torque response); dimensionless
+/// functions (S, T, tracking) in dB, as the other reports' Bode charts.
+
+#include <optional>
+#include <string>
+
+#include "servotwin/core/transfer_function.hpp"
+#include "servotwin/report/document.hpp"
+#include "servotwin/tuning/tune.hpp"
+
+namespace servotwin::report {
+
+/// What the report needs beyond the tuner's result.
+struct TuningReportOptions {
+  std::string source;  ///< the plant's name or file, for the subtitle
+  /// The multiplicative uncertainty weight W2(s) the tuning used, in physical s [rad/s] (as
+  /// tuning::TuneOptions::w2): draws |W2 T| and the robust-performance function.
+  std::optional<core::TransferFunction> w2;
+  std::size_t frequency_points =
+      400;  ///< log grid of the frequency charts (plus the plant's and poles' frequencies), >= 16
+  std::size_t time_points = 1200;  ///< samples of each step response, >= 16
+};
+
+/// Builds the report of `result` (a tuning::tune() result):
+///  - "Plant": normalized parameters (ωz and the resonance in Hz, r, ζz, ζp, a, Im, higher
+///    modes, known HF dynamics, the two-mass realization with friction when there is one), the
+///    C7.4 verdict for r, Bode magnitude and phase of the design model, of the model with the
+///    higher modes and of the model with the known HF dynamics (NormalizedPlant::measured_response);
+///  - "Design": design parameters and gains (normalized and physical), the admissible ω* range;
+///    when ω* was chosen automatically the scan (bandwidth, ‖S‖∞ and tracking peak over ω*, the
+///    Ms/Mt limits, the chosen ω*); the closed-loop poles (Hz, damping);
+///  - "Loop shapes": |S|, |T|, |ωm/ω*|, |ωl/ω*| with the Ms/Mt lines; the closed- and open-loop
+///    load-torque response |ωl/Tl|; the controller |C(jω)|; margins and peaks;
+///  - "Robustness" (with W2): |W2|, |W2 T|, |S|/Ms + |W2 T| against 1 and the RS/NP/RP table;
+///  - "Position loop" (pi+p): |φl/φ*| and |φl/Tl| at the chosen Kpp and the Kpp limits;
+///  - "Time responses (linear)": unit setpoint step (motor and load velocity, motor torque) and unit
+///    load-torque step from the rational closed loop by exact zero-order-hold simulation.
+/// core::InputError (field "frequency_points" / "time_points") for options out of range, and
+/// "w2" for a weight that is improper or unstable.
+[[nodiscard]] Document tuning_report(const tuning::TuneResult& result, const TuningReportOptions& options = {});
+
+}  // namespace servotwin::report

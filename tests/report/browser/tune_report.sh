@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# End to end: `servotwin tune --report` on the table-5.1 preset with the P position loop (every
+# section but the robustness charts) and on the motor-bench preset with an automatic omega* and an
+# uncertainty weight (the scan and robustness charts); both reports are opened in headless
+# Chromium by report_browser_check (exit 77 = Chromium missing: CTest skips).
+#   tune_report.sh SERVOTWIN REPORT_BROWSER_CHECK WORK_DIR
+set -euo pipefail
+servotwin=$1
+check=$2
+work=$3
+rm -rf "$work"
+mkdir -p "$work"
+cd "$work"
+"$servotwin" -q tune table-5.1 --structure pi+p --report r.html
+"$servotwin" -q tune motor-bench --w2-num 0.3,0 --w2-den 1,2000 --report w2.html
+exec "$check" --check r.html w2.html
