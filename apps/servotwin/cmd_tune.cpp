@@ -42,14 +42,8 @@ struct TuneArgs {
 
 std::optional<double> parse_omega_star(const std::string& text) {
   if (text == "auto") return std::nullopt;
-  std::size_t used = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size() || !std::isfinite(v) || v <= 0.0) {
+  const std::optional<double> v = parse_number(text);
+  if (!v || *v <= 0.0) {
     throw core::InputError(core::at_field("--omega-star"), "expected \"auto\" or omega*/omega_z > 0, got \"" + text + "\"");
   }
   return v;

@@ -1,5 +1,6 @@
 #include "tune_input.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
@@ -86,6 +87,18 @@ TunePlant load_tune_plant(const std::string& name_or_path) {
   return from_description(io::load_plant(name_or_path), name_or_path);
 }
 
+std::optional<double> parse_number(const std::string& text) {
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (used != text.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
 core::Polynomial parse_coefficients(const std::string& text, const std::string& option) {
   std::string cleaned = text;
   for (char& ch : cleaned) {
@@ -95,18 +108,12 @@ core::Polynomial parse_coefficients(const std::string& text, const std::string& 
   std::vector<double> c;
   std::string token;
   while (in >> token) {
-    std::size_t used = 0;
-    double v = 0.0;
-    try {
-      v = std::stod(token, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != token.size() || !std::isfinite(v)) {
+    const std::optional<double> v = parse_number(token);
+    if (!v) {
       throw core::InputError(core::at_field(option),
                              fmt::format("expected coefficients in descending powers of s (e.g. \"2.6,0\"), got \"{}\"", token));
     }
-    c.push_back(v);
+    c.push_back(*v);
   }
   const core::Polynomial p(c);
   if (p.is_zero()) throw core::InputError(core::at_field(option), "expected at least one non-zero coefficient");

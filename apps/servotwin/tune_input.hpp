@@ -26,6 +26,9 @@ struct TunePlant {
 /// preset name (servotwin machine --list-flexible). core::InputError names the file and field.
 TunePlant load_tune_plant(const std::string& name_or_path);
 
+/// The whole of `text` as a finite number, or std::nullopt.
+std::optional<double> parse_number(const std::string& text);
+
 /// Parses a coefficient list "2.6, 0" or "2.6 0" (descending powers of s) for option `option`.
 core::Polynomial parse_coefficients(const std::string& text, const std::string& option);
 

@@ -61,10 +61,9 @@ std::vector<double> scan_grid(const NormalizedPlant& plant) {
 struct GainDesigner {
   const NormalizedPlant& plant;
   const TuneOptions& options;
-  double omega_z;
 
   [[nodiscard]] double tau_normalized(double omega_star) const {
-    return options.tau ? *options.tau * omega_z : default_derivative_time_constant(plant.r, omega_star);
+    return options.tau ? *options.tau * plant.omega_z : default_derivative_time_constant(plant.r, omega_star);
   }
 
   [[nodiscard]] PidGains operator()(double omega_star, std::vector<std::string>* warnings = nullptr) const {
@@ -99,6 +98,7 @@ struct SpecCheck {
   const TuneOptions& options;
   std::optional<core::TransferFunction> w2;  // normalized time
   std::vector<double> grid;
+  std::vector<double> bandwidth_grid;  // the grid with ω = 0 first (the DC reference of the bandwidth)
 
   [[nodiscard]] TuneResult::Candidate operator()(double omega_star, const PidGains& gains) const {
     TuneResult::Candidate c;
@@ -110,9 +110,7 @@ struct SpecCheck {
     const bool load = loop.has_load();
     const auto tracking = [&](double w) { return load ? loop.load_tracking(w) : loop.motor_tracking(w); };
     c.peak_tracking = core::peak_on_grid(tracking, grid, 1e-4).value;
-    std::vector<double> bw_grid{0.0};
-    bw_grid.insert(bw_grid.end(), grid.begin(), grid.end());
-    c.bandwidth = core::bandwidth(tracking, bw_grid).value_or(0.0);
+    c.bandwidth = core::bandwidth(tracking, bandwidth_grid).value_or(0.0);
     c.feasible = c.peak_s <= options.ms && c.peak_tracking <= options.mt;
     if (c.feasible && w2) c.feasible = robustness(loop, *w2, options.ms, scan_robustness_options()).rp_ok;
     return c;
@@ -202,8 +200,10 @@ void add_discrete(Controller& c, double ts) {
 void add_position_loop(Controller& c, const VelocityLoop& loop, const std::optional<core::TransferFunction>& w2,
                        const NormalizedPlant& plant) {
   // With higher modes the load side is that of the first mode's two-mass realization.
-  const VelocityLoop first_mode(plant, c.normalized, true, false);
-  if (!first_mode.has_load()) {
+  std::optional<VelocityLoop> first_mode;
+  if (!loop.has_load()) first_mode.emplace(plant, c.normalized, true, false);
+  const VelocityLoop& base = first_mode ? *first_mode : loop;
+  if (!base.has_load()) {
     throw InputError(at_field("--structure"),
                      "pi+p needs the load side of a two-mass realization, and this plant has none (its friction "
                      "terms would be negative); tune the velocity loop with --structure pi");
@@ -211,7 +211,7 @@ void add_position_loop(Controller& c, const VelocityLoop& loop, const std::optio
   if (!plant.higher_modes.empty()) {
     c.notes.push_back("the position loop is designed on the first mode's two-mass realization (higher modes left out)");
   }
-  const PositionLoop position(functions_of(loop.has_load() ? loop : first_mode), w2);
+  const PositionLoop position(functions_of(base), w2);
   const PositionLoopDesign d = position.design();
   if (!(d.kpp_nominal > 0.0)) {
     throw InputError(at_field("--structure"), "no position gain keeps the load position free of overshoot");
@@ -250,7 +250,7 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
                                  "recommend passive methods: a notch filter or an input shaper (servotwin shaper)",
                                  plant.r, kRatioForPassiveMethods));
   }
-  const GainDesigner design{plant, options, plant.omega_z};
+  const GainDesigner design{plant, options};
   const double kd = options.structure == Structure::kPid ? virtual_inertia_kd(plant.r, options.target_r) : 0.0;
   result.range = admissible_range(plant, options.zeta_star, kd);
   if (result.range.empty()) {
@@ -261,7 +261,10 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   }
   std::optional<core::TransferFunction> w2_normalized;
   if (options.w2) w2_normalized = to_normalized_time(*options.w2, plant.omega_z);
-  const SpecCheck check{plant, options, w2_normalized, scan_grid(plant)};
+  const std::vector<double> grid = scan_grid(plant);
+  std::vector<double> bandwidth_grid{0.0};
+  bandwidth_grid.insert(bandwidth_grid.end(), grid.begin(), grid.end());
+  const SpecCheck check{plant, options, w2_normalized, grid, bandwidth_grid};
   Controller& c = result.controller;
   c.structure = options.structure;
   c.plant = scales(plant);

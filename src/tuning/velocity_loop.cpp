@@ -123,7 +123,13 @@ VelocityLoop::VelocityLoop(const NormalizedPlant& plant, const PidGains& gains, 
     }
   }
   const TransferFunction pade = pade_delay(delay_, pade_order_);
-  characteristic_ = rational(pade.num(), pade.den()).characteristic;
+  characteristic_ = characteristic(pade.num(), pade.den());
+}
+
+Polynomial VelocityLoop::characteristic(const Polynomial& delay_num, const Polynomial& delay_den) const {
+  // The same products, in the same order, as rational(): both give the identical Δ.
+  return controller_.feedback.den() * (act_den_ * delay_den) * fb_den_ * plant_den_ +
+         controller_.feedback.num() * (act_num_ * delay_num) * fb_num_ * plant_num_;
 }
 
 VelocityLoop::Values VelocityLoop::values(double omega) const noexcept {

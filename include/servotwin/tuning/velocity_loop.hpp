@@ -121,6 +121,8 @@ class VelocityLoop {
   struct Values;
   [[nodiscard]] Values values(double omega) const noexcept;
   [[nodiscard]] ClosedLoopTransfer rational(const core::Polynomial& delay_num, const core::Polynomial& delay_den) const;
+  /// Δ alone (what stable() needs), without the closed-loop numerators.
+  [[nodiscard]] core::Polynomial characteristic(const core::Polynomial& delay_num, const core::Polynomial& delay_den) const;
 
   PidGains gains_;
   ControllerTf controller_;
