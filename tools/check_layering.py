@@ -18,7 +18,7 @@ ALLOWED = {
     "fit": {"core"},
     "shaping": {"core", "fit"},
     "tuning": {"core", "fit"},
-    "vcnc": {"core", "motion", "machine", "rapid", "frf", "fit"},
+    "vcnc": {"core", "motion", "machine", "rapid", "frf", "fit", "tuning"},
     "io": {"core", "motion", "machine", "rapid", "vcnc", "frf", "fit", "shaping", "tuning"},
     "report": {"core", "motion", "machine", "rapid", "vcnc", "frf", "fit", "shaping", "tuning", "io"},
 }

@@ -18,7 +18,6 @@ namespace servotwin::cli {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 struct FitArgs {
   std::string frf;

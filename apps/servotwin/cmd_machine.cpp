@@ -23,7 +23,7 @@ std::string describe_root(const nlohmann::json& r) {
   return fmt::format("{:.2f} Hz, real{}", r["hz"].get<double>(), zeta < 0 ? " (unstable)" : "");
 }
 
-void print_roots(const char* label, const nlohmann::json& roots) {
+void print_machine_roots(const char* label, const nlohmann::json& roots) {
   fmt::print("  {}:", label);
   if (roots.empty()) fmt::print(" none");
   for (std::size_t i = 0; i < roots.size(); ++i) {
@@ -45,8 +45,8 @@ void print_text(const machine::MachineConfig& m, const nlohmann::json& report) {
     fmt::print("  a1 = {:.2f}  a2 = {:.2f}  a3 = {:.2f}\n", c["a1"].get<double>(), c["a2"].get<double>(), c["a3"].get<double>());
     fmt::print("  b0 = {:.2f}  b1 = {:.2f}  b2 = {:.2f}\n", c["b0"].get<double>(), c["b1"].get<double>(), c["b2"].get<double>());
     fmt::print("  d0 = {:.2f}  d1 = {:.2f}\n", c["d0"].get<double>(), c["d1"].get<double>());
-    print_roots("poles", axis["poles"]);
-    print_roots("zeros", axis["zeros"]);
+    print_machine_roots("poles", axis["poles"]);
+    print_machine_roots("zeros", axis["zeros"]);
   }
 }
 

@@ -12,7 +12,6 @@ namespace servotwin::cli {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 struct ModelArgs {
   std::string model;

@@ -19,7 +19,6 @@ namespace servotwin::cli {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 struct DesignArgs {
   std::string type;

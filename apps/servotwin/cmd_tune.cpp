@@ -6,6 +6,8 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "command.hpp"
 #include "report_output.hpp"
@@ -15,13 +17,13 @@
 #include "servotwin/report/tuning_report.hpp"
 #include "servotwin/tuning/tune.hpp"
 #include "servotwin/tuning/uncertainty.hpp"
+#include "servotwin/vcnc/drive_simulation.hpp"
 #include "tune_input.hpp"
 
 namespace servotwin::cli {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 struct TuneArgs {
   std::string plant;
@@ -151,6 +153,44 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
   for (const std::string& n : c.notes) fmt::print("note: {}\n", n);
 }
 
+void print_verification(const vcnc::DriveSimulation& sim) {
+  const vcnc::DriveMetrics& m = sim.metrics;
+  const vcnc::DriveMetrics& l = sim.linear_metrics;
+  const auto time = [](double t) { return std::isfinite(t) ? fmt::format("{:.4g} s", t) : std::string("never"); };
+  if (sim.test == vcnc::DriveTest::kSetpointStep) {
+    fmt::print("  step of {:g}: overshoot {:.1f} % (linear {:.1f} %), settling {} (linear {}), final error {:.3g}\n",
+               sim.amplitude, 100.0 * m.overshoot, 100.0 * l.overshoot, time(m.settling_time), time(l.settling_time),
+               m.final_error);
+  } else {
+    fmt::print("  load step of {:.4g}: peak deviation {:.4g} (linear {:.4g}), recovery {} (linear {}), final deviation "
+               "{:.3g} (linear {:.3g})\n",
+               sim.amplitude, m.peak_deviation, l.peak_deviation, time(m.recovery_time), time(l.recovery_time),
+               0.0 - m.final_error, 0.0 - l.final_error);
+  }
+  for (const std::string& n : sim.notes) fmt::print("  note: {}\n", n);
+}
+
+/// The design run on the plant description with its nonlinearities: a unit setpoint step, then a
+/// load step as large as the step's peak torque on the linear part (comparable torque levels
+/// whatever the units). A plant that cannot be run this way only gets a note.
+std::vector<vcnc::DriveSimulation> verify_on_plant(const TunePlant& plant, const tuning::Controller& controller) {
+  std::vector<vcnc::DriveSimulation> runs;
+  if (!plant.description) return runs;
+  try {
+    fmt::print("verified by simulation on the plant with its nonlinearities:\n");
+    runs.push_back(vcnc::simulate_drive(*plant.description, controller));
+    print_verification(runs.back());
+    vcnc::DriveSimulationSettings load;
+    load.test = vcnc::DriveTest::kLoadStep;
+    load.amplitude = runs.back().linear_metrics.peak_torque;
+    runs.push_back(vcnc::simulate_drive(*plant.description, controller, load));
+    print_verification(runs.back());
+  } catch (const core::InputError& e) {
+    fmt::print("  not simulated: {}\n", e.what());
+  }
+  return runs;
+}
+
 int run(const TuneArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   TunePlant plant = load_tune_plant(a.plant);
@@ -160,6 +200,7 @@ int run(const TuneArgs& a, const GlobalOptions& global) {
   tuning::TuneResult result = tuning::tune(plant.model, options);
   for (const std::string& n : plant.notes) result.controller.notes.push_back(n);
   print_summary(result, a.plant);
+  std::vector<vcnc::DriveSimulation> verification = verify_on_plant(plant, result.controller);
   if (out) {
     out->stream() << io::controller_to_json(result.controller, a.plant).dump(2) << "\n";
     out->commit();
@@ -169,6 +210,7 @@ int run(const TuneArgs& a, const GlobalOptions& global) {
     report::TuningReportOptions report_options;
     report_options.source = a.plant;
     report_options.w2 = options.w2;
+    report_options.simulations = std::move(verification);
     write_report(report::tuning_report(result, report_options), *report_file, global);
   }
   return kSuccess;

@@ -6,6 +6,7 @@
 #include <fmt/core.h>
 #include <functional>
 #include <memory>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,9 @@
 #include "servotwin/motion/program.hpp"
 
 namespace servotwin::cli {
+
+/// 2π: Hz ↔ rad/s in what the commands print.
+inline constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 /// Exit statuses (README "Command line").
 enum ExitStatus : int { kSuccess = 0, kInternalError = 1, kUsageError = 2, kBadInput = 3 };
@@ -43,6 +47,7 @@ void register_frf(CLI::App& app, Action& selected);
 void register_fit(CLI::App& app, Action& selected);
 void register_shaper(CLI::App& app, Action& selected);
 void register_tune(CLI::App& app, Action& selected);
+void register_simulate(CLI::App& app, Action& selected);
 
 /// Progress line on stderr (suppressed by --quiet).
 template <typename... Args>

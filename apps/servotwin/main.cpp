@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   Action selected;
   for (Registrar add : {register_gcode, register_interpolate, register_capture, register_import, register_identify, register_solve,
                          register_model, register_predict, register_machine, register_demo, register_frf, register_fit, register_shaper,
-                         register_tune})
+                         register_tune, register_simulate})
     add(app, selected);
 
   try {

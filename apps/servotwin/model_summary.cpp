@@ -1,5 +1,7 @@
 #include "model_summary.hpp"
 
+#include "command.hpp"
+
 #include <cmath>
 #include <fmt/core.h>
 #include <numbers>
@@ -7,7 +9,6 @@
 namespace servotwin::cli {
 
 namespace {
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 std::string root_text(const core::ModalInfo& m) {
   if (!std::isfinite(m.freq_hz)) return "at infinity";

@@ -28,7 +28,6 @@ namespace servotwin::cli {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr std::size_t kCandidatesShown = 5;
 
 struct MultimodeArgs {

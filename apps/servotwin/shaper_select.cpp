@@ -23,7 +23,6 @@ namespace servotwin::cli {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 struct SelectArgs {
   std::string input;

@@ -25,7 +25,6 @@ void add_solver_options(CLI::App& command, SolverInput& input) {
 }
 
 void apply_solver_input(const SolverInput& input, vcnc::IdentificationSettings& settings) {
-  constexpr double kTwoPi = 2.0 * std::numbers::pi;
   settings.method = input.method;
   settings.bounds.p_min = kTwoPi * input.p_min_hz;
   settings.bounds.p_max = kTwoPi * input.p_max_hz;

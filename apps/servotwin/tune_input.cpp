@@ -64,6 +64,7 @@ TunePlant from_description(const machine::PlantConfig& config, const std::string
   // configured transport delay.
   p.hf.delay_s = (static_cast<double>(s.delay_samples) + 0.5) * s.ts;
   p.ts = s.ts;
+  p.description = config;
   if (const auto* chain = std::get_if<machine::MassChain>(&config.model)) {
     bool friction = false, backlash = false;
     for (std::size_t i = 0; i < chain->masses(); ++i) friction = friction || chain->friction_of(i).active();

@@ -9,6 +9,7 @@
 
 #include "servotwin/core/transfer_function.hpp"
 #include "servotwin/fit/plant_model.hpp"
+#include "servotwin/machine/flexible_plant.hpp"
 #include "servotwin/tuning/normalized_plant.hpp"
 
 namespace servotwin::cli {
@@ -20,6 +21,9 @@ struct TunePlant {
   std::optional<double> ts;         ///< a plant description's sample period
   std::vector<std::string> notes;   ///< what was set aside (friction, backlash, ...)
   bool fitted = false;              ///< read from a fitted plant-model file (residuals make sense)
+  /// The plant description (file or preset) itself, nonlinearities included: the design is
+  /// verified on it by simulation.
+  std::optional<machine::PlantConfig> description;
 };
 
 /// Reads `name_or_path`: a servotwin.plant-model/1 file, a servotwin.plant/1 file or a flexible

@@ -364,7 +364,12 @@ void FlexiblePlant::build_mass_chain(const MassChain& chain) {
   lag_index_ = lag > 0.0 ? states_ - 1 : -1;
   const double ts = config_.settings.ts;
   if (!nonlinear_) {
-    ab_ = transition(a, b.leftCols(1), ts);
+    // Inputs [u, Tl]: b's columns are [u, f_1 .. f_n] with f_i a torque on mass i, and the load
+    // torque opposes the motion of the last mass.
+    Eigen::MatrixXd inputs(b.rows(), 2);
+    inputs.col(0) = b.col(0);
+    inputs.col(1) = -b.col(static_cast<Eigen::Index>(n_));
+    ab_ = transition(a, inputs, ts);
     substeps_ = 1;
   } else {
     substeps_ = config_.settings.substeps;
@@ -387,7 +392,7 @@ void FlexiblePlant::build_mass_chain(const MassChain& chain) {
       regime_.push_back(transition(a, b, h));
     }
   }
-  xw_.setZero(states_ + 1 + static_cast<Eigen::Index>(n_));
+  xw_.setZero(states_ + 1 + static_cast<Eigen::Index>(n_));  // also holds [x; u; Tl] of the linear step
   next_.setZero(states_);
   x_.setZero(states_);
 }
@@ -456,10 +461,11 @@ double FlexiblePlant::shaft_torque(std::size_t shaft) const {
   return stiffness_[shaft] * (twist - hg * sign(twist)) + shaft_damping_[shaft] * rate;
 }
 
-double FlexiblePlant::external_torque(std::size_t mass, double u) const noexcept {
+double FlexiblePlant::external_torque(std::size_t mass, double u, double load) const noexcept {
   const auto i = static_cast<Eigen::Index>(mass);
   double t = -viscous_[mass] * x_(2 * i + 1);
   if (mass == 0) t += lag_index_ >= 0 ? x_(lag_index_) : u;
+  if (mass + 1 == n_) t -= load;
   // shaft_torque cannot throw for valid indices; repeated inline to stay noexcept.
   const auto torque = [this](std::size_t s) noexcept {
     const auto e = static_cast<Eigen::Index>(s);
@@ -473,12 +479,13 @@ double FlexiblePlant::external_torque(std::size_t mass, double u) const noexcept
   return t;
 }
 
-void FlexiblePlant::advance_linear(double u) noexcept {
+void FlexiblePlant::advance_linear(double u, double load) noexcept {
   const Eigen::Index n = states_;
-  const Eigen::Index width = n + 1;
+  const Eigen::Index width = ab_.cols();  // n + 1, or n + 2 with a chain's load-torque input
   double* xw = xw_.data();
   for (Eigen::Index i = 0; i < n; ++i) xw[i] = x_[i];
   xw[n] = u;
+  if (width > n + 1) xw[n + 1] = load;
   double* x = x_.data();
   for (Eigen::Index r = 0; r < n; ++r) {
     const double* row = ab_.data() + r * width;
@@ -488,7 +495,7 @@ void FlexiblePlant::advance_linear(double u) noexcept {
   }
 }
 
-void FlexiblePlant::advance_nonlinear(double u) noexcept {
+void FlexiblePlant::advance_nonlinear(double u, double load) noexcept {
   const Eigen::Index n = states_;
   const Eigen::Index width = n + 1 + static_cast<Eigen::Index>(n_);
   const std::size_t f = friction_masses_.size();
@@ -499,6 +506,7 @@ void FlexiblePlant::advance_nonlinear(double u) noexcept {
   for (int step = 0; step < substeps_; ++step) {
     std::size_t regime = 0;
     for (std::size_t i = 0; i < n_; ++i) force[i] = 0.0;
+    force[n_ - 1] = -load;
     for (std::size_t j = 0; j < backlash_shafts_.size(); ++j) {
       const std::size_t s = backlash_shafts_[j];
       const auto e = static_cast<Eigen::Index>(s);
@@ -520,7 +528,7 @@ void FlexiblePlant::advance_nonlinear(double u) noexcept {
       const auto& fr = friction_[i];
       const double v = x_(w);
       if (std::abs(v) <= fr.stick_band) {
-        const double te = external_torque(i, u);
+        const double te = external_torque(i, u, load);
         if (std::abs(te) < fr.static_level()) {
           x_(w) = 0.0;  // Karnopp stick: the velocity is exactly zero, the mass pinned
           regime |= std::size_t{1} << j;
@@ -590,8 +598,9 @@ PlantMeasurement FlexiblePlant::make_measurement(double y_exact) noexcept {
   return m;
 }
 
-PlantMeasurement FlexiblePlant::step(double torque_command) noexcept {
+PlantMeasurement FlexiblePlant::step(double torque_command, double load_torque) noexcept {
   double u = std::isfinite(torque_command) ? torque_command : 0.0;
+  const double load = std::isfinite(load_torque) ? load_torque : 0.0;
   if (!delay_line_.empty()) {
     const double delayed = delay_line_[delay_pos_];
     delay_line_[delay_pos_] = u;
@@ -599,8 +608,8 @@ PlantMeasurement FlexiblePlant::step(double torque_command) noexcept {
     u = delayed;
   }
   last_u_ = u;
-  if (nonlinear_) advance_nonlinear(u);
-  else advance_linear(u);
+  if (nonlinear_) advance_nonlinear(u, load);
+  else advance_linear(u, load);
   return make_measurement(exact_output());
 }
 

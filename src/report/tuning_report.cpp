@@ -14,6 +14,7 @@
 #include "number_format.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/state_space.hpp"
+#include "servotwin/report/drive_report.hpp"
 #include "servotwin/tuning/position_loop.hpp"
 #include "servotwin/tuning/uncertainty.hpp"
 #include "servotwin/tuning/velocity_loop.hpp"
@@ -700,6 +701,8 @@ Document tuning_report(const tuning::TuneResult& result, const TuningReportOptio
   if (result.controller.position && result.controller.kpp_normalized)
     doc.sections.push_back(position_section(c, base, w2n));
   doc.sections.push_back(time_section(c, loop, base));
+  for (const vcnc::DriveSimulation& sim : options.simulations)
+    doc.sections.push_back(drive_section(sim, fmt::format("Simulation on the plant: {}", vcnc::to_string(sim.test))));
   return doc;
 }
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "json_fixture.hpp"
+#include "servotwin/core/transfer_function.hpp"
 #include "servotwin/core/polynomial.hpp"
 #include "servotwin/core/state_space.hpp"
 
@@ -27,6 +28,13 @@ inline void PrintTo(const Polynomial& p, std::ostream* os) {
 }  // namespace servotwin::core
 
 namespace servotwin::core::test {
+
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// A transfer function from coefficient lists (descending powers of s).
+inline TransferFunction tf(std::vector<double> num, std::vector<double> den) {
+  return {Polynomial(std::move(num)), Polynomial(std::move(den))};
+}
 
 inline const nlohmann::json& core_reference() {
   static const nlohmann::json data = test_support::read_json_fixture("core/core_reference.json", "core_reference.py");

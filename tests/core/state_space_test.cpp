@@ -19,9 +19,7 @@ using test::reference_case;
 using test::reference_section;
 using test::to_matrix;
 
-TransferFunction tf(std::vector<double> num, std::vector<double> den) {
-  return {Polynomial(std::move(num)), Polynomial(std::move(den))};
-}
+using test::tf;
 
 StateSpace ss_from_case(const nlohmann::json& c) {
   return {to_matrix(c.at("A")), to_matrix(c.at("B")), to_matrix(c.at("C")), to_matrix(c.at("D"))};

@@ -33,7 +33,7 @@ using test::control_reference;
 using test::reference_system;
 using test::system_from;
 using test::to_matrix;
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using test::kInf;
 
 double sigma_max_at(const StateSpace& s, double omega) {
   return Eigen::JacobiSVD<Eigen::MatrixXcd>(frequency_response(s, omega)).singularValues()(0);

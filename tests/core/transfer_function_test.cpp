@@ -15,12 +15,10 @@ namespace servotwin::core {
 namespace {
 
 using Complex = std::complex<double>;
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using test::kInf;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
-TransferFunction tf(std::vector<double> num, std::vector<double> den) {
-  return {Polynomial(std::move(num)), Polynomial(std::move(den))};
-}
+using test::tf;
 
 TransferFunction from_case(const nlohmann::json& c) {
   return tf(c.at("num").get<std::vector<double>>(), c.at("den").get<std::vector<double>>());

@@ -16,6 +16,8 @@
 
 namespace servotwin::frf {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace rfid_block_test {
 
 using Complex = std::complex<double>;
 constexpr double kPi = std::numbers::pi;
@@ -354,5 +356,6 @@ TEST(RfidBlock, RejectsBadParametersNamingTheField) {
   EXPECT_EQ(field_of([](RfidParameters& p) { p.extremum_prominence = 1.0; }), "extremum_prominence");
 }
 
+}  // namespace rfid_block_test
 }  // namespace
 }  // namespace servotwin::frf

@@ -25,6 +25,8 @@
 
 namespace servotwin::io {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace controller_json_test {
 
 using tuning::Controller;
 using tuning::PidGains;
@@ -574,5 +576,6 @@ TEST(ControllerJsonWriter, RefusesControllersThatCannotBeWritten) {
   EXPECT_THROW((void)controller_to_json(c, ""), std::invalid_argument);
 }
 
+}  // namespace controller_json_test
 }  // namespace
 }  // namespace servotwin::io

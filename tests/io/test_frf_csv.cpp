@@ -15,6 +15,8 @@
 #include "servotwin/io/frf_csv.hpp"
 
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace frf_csv_test {
 
 using servotwin::core::FrequencyPoint;
 using servotwin::core::FrequencyResponse;
@@ -165,4 +167,5 @@ TEST(FrfCsv, WriterRefusesWhatTheReaderWouldReject) {
   EXPECT_THROW(servotwin::io::write_frf_csv(out, sample(), {"two\nlines"}), std::invalid_argument);
 }
 
+}  // namespace frf_csv_test
 }  // namespace

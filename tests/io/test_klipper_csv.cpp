@@ -11,6 +11,8 @@
 
 namespace servotwin::io {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace klipper_csv_test {
 
 std::string data(const std::string& relative) { return std::string(SERVOTWIN_REPO_DATA_DIR) + "/" + relative; }
 
@@ -108,5 +110,6 @@ TEST(KlipperCsv, BadInputNamesFileLineColumnAndValue) {
   EXPECT_THROW((void)load_klipper_csv("/nonexistent/r.csv"), core::InputError);
 }
 
+}  // namespace klipper_csv_test
 }  // namespace
 }  // namespace servotwin::io

@@ -8,6 +8,8 @@
 #include "servotwin/machine/presets.hpp"
 
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace machine_json_test {
 
 using servotwin::core::InputError;
 using servotwin::io::parse_machine_json;
@@ -116,4 +118,5 @@ TEST(MachineJson, ClosedLoopReportHasThesisTable34Coefficients) {
   EXPECT_EQ(x["poles"].size(), 3U);
 }
 
+}  // namespace machine_json_test
 }  // namespace

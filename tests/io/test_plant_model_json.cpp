@@ -12,6 +12,8 @@
 
 namespace servotwin::io {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace plant_model_json_test {
 
 fit::FitReport e10_report(bool lag) {
   fit::PlantModel truth;
@@ -84,5 +86,6 @@ TEST(PlantModelJson, ErrorsNameTheField) {
   EXPECT_THROW(load_plant_model("/nonexistent/plant.json"), core::InputError);
 }
 
+}  // namespace plant_model_json_test
 }  // namespace
 }  // namespace servotwin::io

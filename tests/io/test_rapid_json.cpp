@@ -10,6 +10,8 @@
 #include "servotwin/io/rapid_json.hpp"
 
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace rapid_json_test {
 
 using servotwin::core::InputError;
 using ::testing::HasSubstr;
@@ -162,4 +164,5 @@ TEST(RapidJson, ModelFileErrors) {
               HasSubstr("(ts)"));
 }
 
+}  // namespace rapid_json_test
 }  // namespace

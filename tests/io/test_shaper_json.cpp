@@ -11,6 +11,8 @@
 
 namespace servotwin::io {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace shaper_json_test {
 
 std::string error_of(const std::string& text) {
   try {
@@ -71,5 +73,6 @@ TEST(ShaperJson, RejectsBadDocumentsNamingTheField) {
   EXPECT_EQ(error_of(with("amplitudes", {0.5, 0.5 + 5e-10})), "no error");
 }
 
+}  // namespace shaper_json_test
 }  // namespace
 }  // namespace servotwin::io

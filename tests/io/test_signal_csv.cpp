@@ -10,6 +10,8 @@
 #include "servotwin/io/signal_csv.hpp"
 
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace signal_csv_test {
 
 using servotwin::core::InputError;
 using servotwin::io::read_signal_csv;
@@ -185,4 +187,5 @@ TEST(SignalCsv, ReadsTheFdiToolsRecording) {
               ::testing::ThrowsMessage<InputError>(HasSubstr("cannot open")));
 }
 
+}  // namespace signal_csv_test
 }  // namespace

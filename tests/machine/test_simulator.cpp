@@ -20,6 +20,8 @@
 
 namespace servotwin::machine {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace simulator_test {
 
 using Complex = std::complex<double>;
 using test::reference;
@@ -477,5 +479,6 @@ TEST(Simulator, ResultsScaleWithTheLengthUnit) {
   }
 }
 
+}  // namespace simulator_test
 }  // namespace
 }  // namespace servotwin::machine

@@ -11,6 +11,8 @@
 
 namespace servotwin::motion {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace gcode_iso_test {
 
 using test::iso;
 using test::iso_error;
@@ -374,5 +376,6 @@ TEST(GcodeIso, EmptyProgram) {
   EXPECT_TRUE(iso("%\n\n%\n").blocks.empty());
 }
 
+}  // namespace gcode_iso_test
 }  // namespace
 }  // namespace servotwin::motion

@@ -12,6 +12,8 @@
 
 namespace servotwin::motion {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace interpolation_geometry_test {
 
 using interp_test::norm;
 using interp_test::ProgramBuilder;
@@ -352,5 +354,6 @@ TEST(InterpolationValidation, AbsurdSizesAreRejected) {
   EXPECT_THROW((void)plan_motion(ok.program(), tiny), core::InputError);
 }
 
+}  // namespace interpolation_geometry_test
 }  // namespace
 }  // namespace servotwin::motion

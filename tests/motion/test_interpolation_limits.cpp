@@ -16,6 +16,8 @@
 
 namespace servotwin::motion {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace interpolation_limits_test {
 
 using interp_test::add;
 using interp_test::check_limits;
@@ -366,5 +368,6 @@ TEST(InterpolationLimits, ArcSamplesStayOnTheCircle) {
   }
 }
 
+}  // namespace interpolation_limits_test
 }  // namespace
 }  // namespace servotwin::motion

@@ -13,6 +13,8 @@
 
 namespace servotwin::rapid {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace axis_model_metrics_test {
 
 constexpr double kTs = 1e-3;
 
@@ -111,5 +113,6 @@ TEST(AxisModelMetrics, SimulationFitOnIdentificationAndValidationCaptures) {
   }
 }
 
+}  // namespace axis_model_metrics_test
 }  // namespace
 }  // namespace servotwin::rapid

@@ -17,6 +17,8 @@
 
 namespace servotwin::rapid {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace axis_model_simulation_test {
 
 using test::doubles;
 using test::reference_model;
@@ -349,5 +351,6 @@ TEST(AxisModelSimulation, BadInputAndDegenerateCases) {
   EXPECT_THROW((void)exploding.simulate(std::vector<double>(5, 0.0)), core::InputError);
 }
 
+}  // namespace axis_model_simulation_test
 }  // namespace
 }  // namespace servotwin::rapid

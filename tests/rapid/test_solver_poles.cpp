@@ -14,6 +14,8 @@
 
 namespace servotwin::rapid {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace solver_poles_test {
 
 constexpr double kTwoPi = test::kTwoPi;
 
@@ -108,5 +110,6 @@ TEST(SolverPoles, LogJacobianMatchesFiniteDifferences) {
   }
 }
 
+}  // namespace solver_poles_test
 }  // namespace
 }  // namespace servotwin::rapid

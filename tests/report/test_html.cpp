@@ -13,6 +13,8 @@
 
 namespace servotwin::report {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace html_test {
 
 using testing::chart_data;
 using testing::count;
@@ -308,5 +310,6 @@ TEST(Html, EmptyDocumentIsStillAPage) {
   EXPECT_EQ(html.find("<nav"), std::string::npos);
 }
 
+}  // namespace html_test
 }  // namespace
 }  // namespace servotwin::report

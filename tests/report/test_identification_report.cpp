@@ -14,6 +14,8 @@
 
 namespace servotwin::report {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace identification_report_test {
 
 using testing::chart_data;
 using testing::render;
@@ -257,5 +259,6 @@ TEST(IdentificationReport, MissingAxisNamesTheCapture) {
   EXPECT_THROW(identification_report(std::span<const vcnc::AxisIdentification>{}, f.captures, {}), core::InputError);
 }
 
+}  // namespace identification_report_test
 }  // namespace
 }  // namespace servotwin::report

@@ -36,7 +36,7 @@ TEST(PredictionReport, ChartsCarryThePredictionAndThePathIsMagnifiedExactly) {
   const Document doc = prediction_report("circle.nc", p, nullptr);
   std::vector<std::string> titles;
   for (const auto& s : doc.sections) titles.push_back(s.title);
-  EXPECT_THAT(titles, testing::ElementsAre("circle.nc: summary", "circle.nc: tracking errors", "circle.nc: contour error",
+  EXPECT_THAT(titles, ::testing::ElementsAre("circle.nc: summary", "circle.nc: tracking errors", "circle.nc: contour error",
                                            "circle.nc: path"));
 
   const Chart* over_time = find_chart(doc, "Contour error over time");

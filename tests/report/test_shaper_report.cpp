@@ -20,6 +20,8 @@
 
 namespace servotwin::report {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace shaper_report_test {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
@@ -277,5 +279,6 @@ TEST(ShaperReport, BadInputIsNamed) {
   expect_field([&] { (void)shaper_comparison(bad); }, "shapers[0]");
 }
 
+}  // namespace shaper_report_test
 }  // namespace
 }  // namespace servotwin::report

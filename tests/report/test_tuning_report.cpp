@@ -27,6 +27,8 @@
 
 namespace servotwin::report {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace tuning_report_test {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
@@ -394,5 +396,6 @@ TEST(TuningReport, BadOptionsAreInputErrors) {
   }
 }
 
+}  // namespace tuning_report_test
 }  // namespace
 }  // namespace servotwin::report

@@ -18,6 +18,8 @@
 
 namespace servotwin::shaping {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace realtime_shaper_test {
 
 const nlohmann::json& e18_case() {
   static const nlohmann::json doc = test::load_fixture("discrete_reference.json");
@@ -177,5 +179,6 @@ TEST(RealtimeShaper, RejectsMalformedDiscreteShapers) {
   EXPECT_THROW(MultiAxisShaper(e18(), std::vector<double>{}), core::InputError);
 }
 
+}  // namespace realtime_shaper_test
 }  // namespace
 }  // namespace servotwin::shaping

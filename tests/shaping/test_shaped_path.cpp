@@ -22,7 +22,7 @@ const nlohmann::json& corner_reference() {
 }
 
 TEST(ShapedPath, CircleShrinksToTheClosedFormRadius) {
-  const double pi = std::numbers::pi;
+  using std::numbers::pi;
   const double R = 10.0, big_omega = 2 * pi * 2.0, ts = 0.001;  // 10 mm at 2 rev/s
   const DiscreteShaper s = discretize(zv4_shaper(2 * pi * 10.0, 0.05, {-0.3, 0.3, 0.0}), ts);
   const std::size_t n = 3000;

@@ -12,6 +12,8 @@
 
 namespace servotwin::validation {
 namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace rapid_identification_test {
 
 /// Expected agreement per preset. PPI and PID meet the thesis's 10 % prediction target. The
 /// sliding-mode loop's tracking error (6.6 um RMS) is a discrete-time effect of its feed-forward
@@ -213,5 +215,6 @@ TEST(EmpsIdentification, SameModelInMetresAndMillimetres) {
   EXPECT_NEAR(a.fit->nrmse, b.fit->nrmse, 1e-8);
 }
 
+}  // namespace rapid_identification_test
 }  // namespace
 }  // namespace servotwin::validation

@@ -212,7 +212,12 @@ class FlexiblePlant {
 
   /// Holds the torque command over one period [k ts, (k+1) ts) and returns the measurement at
   /// (k+1) ts. Non-finite commands are treated as 0 (the hot path has no error channel).
-  PlantMeasurement step(double torque_command) noexcept;
+  ///
+  /// `load_torque` is an external torque Tl on the last mass (the load), held over the period
+  /// like the command and not delayed; it opposes the motion as the dissertation writes it:
+  /// I_n w_n' = T_shaft - Tl - friction (so a positive Tl decelerates a load moving forward).
+  /// A transfer-function plant has no load and ignores it.
+  PlantMeasurement step(double torque_command, double load_torque = 0.0) noexcept;
 
   /// Measurement of the current state without advancing (draws new noise).
   PlantMeasurement measure() noexcept;
@@ -248,9 +253,9 @@ class FlexiblePlant {
 
   void build_mass_chain(const MassChain& chain);
   void build_transfer_function(const core::TransferFunction& tf);
-  void advance_linear(double u) noexcept;
-  void advance_nonlinear(double u) noexcept;
-  [[nodiscard]] double external_torque(std::size_t mass, double u) const noexcept;
+  void advance_linear(double u, double load) noexcept;
+  void advance_nonlinear(double u, double load) noexcept;
+  [[nodiscard]] double external_torque(std::size_t mass, double u, double load) const noexcept;
   [[nodiscard]] double exact_output() const noexcept;
   [[nodiscard]] PlantMeasurement make_measurement(double y_exact) noexcept;
   [[nodiscard]] double next_noise() noexcept;
@@ -263,7 +268,7 @@ class FlexiblePlant {
   Eigen::Index lag_index_ = -1;
   int substeps_ = 1;
 
-  // Linear step: x <- ab_ [x; u] (one period).
+  // Linear step: x <- ab_ [x; u] (one period); a chain's ab_ has a last column for the load torque.
   RowMatrix ab_;
   Eigen::RowVectorXd c_;      // output row (TF plant; chain outputs are read from the state)
   double d_ = 0.0;            // TF feedthrough

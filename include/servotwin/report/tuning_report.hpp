@@ -12,10 +12,12 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "servotwin/core/transfer_function.hpp"
 #include "servotwin/report/document.hpp"
 #include "servotwin/tuning/tune.hpp"
+#include "servotwin/vcnc/drive_simulation.hpp"
 
 namespace servotwin::report {
 
@@ -28,6 +30,9 @@ struct TuningReportOptions {
   std::size_t frequency_points =
       400;  ///< log grid of the frequency charts (plus the plant's and poles' frequencies), >= 16
   std::size_t time_points = 1200;  ///< samples of each step response, >= 16
+  /// Closed-loop simulations of the design on the plant with its nonlinearities
+  /// (vcnc::simulate_drive), each drawn as a section after the linear responses.
+  std::vector<vcnc::DriveSimulation> simulations{};
 };
 
 /// Builds the report of `result` (a tuning::tune() result):
@@ -43,7 +48,8 @@ struct TuningReportOptions {
 ///  - "Robustness" (with W2): |W2|, |W2 T|, |S|/Ms + |W2 T| against 1 and the RS/NP/RP table;
 ///  - "Position loop" (pi+p): |φl/φ*| and |φl/Tl| at the chosen Kpp and the Kpp limits;
 ///  - "Time responses (linear)": unit setpoint step (motor and load velocity, motor torque) and unit
-///    load-torque step from the rational closed loop by exact zero-order-hold simulation.
+///    load-torque step from the rational closed loop by exact zero-order-hold simulation;
+///  - one section per given simulation on the nonlinear plant (report::drive_section).
 /// core::InputError (field "frequency_points" / "time_points") for options out of range, and
 /// "w2" for a weight that is improper or unstable.
 [[nodiscard]] Document tuning_report(const tuning::TuneResult& result, const TuningReportOptions& options = {});

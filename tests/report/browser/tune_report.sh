@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # End to end: `servotwin tune --report` on the table-5.1 preset with the P position loop (every
 # section but the robustness charts) and on the motor-bench preset with an automatic omega* and an
-# uncertainty weight (the scan and robustness charts); both reports are opened in headless
+# uncertainty weight (the scan and robustness charts); then `servotwin simulate --report` of the
+# motor-bench PI on its preset (load step with a torque limit). The reports are opened in headless
 # Chromium by report_browser_check (exit 77 = Chromium missing: CTest skips).
 #   tune_report.sh SERVOTWIN REPORT_BROWSER_CHECK WORK_DIR
 set -euo pipefail
@@ -13,4 +14,6 @@ mkdir -p "$work"
 cd "$work"
 "$servotwin" -q tune table-5.1 --structure pi+p --report r.html
 "$servotwin" -q tune motor-bench --w2-num 0.3,0 --w2-den 1,2000 --report w2.html
-exec "$check" --check r.html w2.html
+"$servotwin" -q tune motor-bench -o pi.json
+"$servotwin" -q simulate --controller pi.json --test load-step --amplitude 0.05 --torque-limit 0.5 --report sim.html
+exec "$check" --check r.html w2.html sim.html

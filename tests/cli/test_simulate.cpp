@@ -1,0 +1,90 @@
+// `servotwin simulate` end to end: a controller tuned from a preset runs on that preset (found
+// through the controller file), its CSV holds the run, the closed-form steady state holds, and the
+// errors users meet are clear.
+#include <cmath>
+#include <sstream>
+
+#include "cli_support.hpp"
+#include "e10_frf.hpp"
+
+namespace servotwin::cli_test {
+namespace {
+
+/// The last CSV row's cells.
+std::vector<std::string> last_row(const std::string& csv) {
+  std::istringstream in(csv);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  std::vector<std::string> cells;
+  std::string cell;
+  std::istringstream row(last);
+  while (std::getline(row, cell, ',')) cells.push_back(cell);
+  return cells;
+}
+
+TEST_F(Cli, SimulateRunsTheTunedControllerOnThePlantItWasTunedFrom) {
+  ASSERT_EQ(run("tune table-5.1 -o pi.json").status, 0);
+  const Result r = run("simulate --controller pi.json --duration 30 -o step.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("on table-5.1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("linear"), std::string::npos) << r.out;
+  const std::string csv = slurp(path("step.csv"));
+  EXPECT_EQ(csv.rfind("# servotwin.drive-simulation/1 test=step structure=pi ts=0.01", 0), 0U) << csv.substr(0, 80);
+  // 30 s at ts = 10 ms: 3001 samples, a comment line and the header.
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3003);
+  // Closed form at the end: sliding at the reference 1 rad/s with Coulomb 0.5 N m on the load and
+  // viscous bm + bl = 1.812431 + 1.787569 = 3.6 N m s/rad (flexible_presets.hpp): the torque
+  // balances 0.5 + 3.6 = 4.1 N m; the linear part carries only the viscous 3.6 N m.
+  const auto cells = last_row(csv);
+  ASSERT_EQ(cells.size(), 14U);
+  EXPECT_NEAR(std::stod(cells[3]), 4.1, 0.02);
+  EXPECT_NEAR(std::stod(cells[5]), 1.0, 0.005);
+  EXPECT_NEAR(std::stod(cells[9]), 3.6, 0.02);
+}
+
+TEST_F(Cli, SimulateLoadStepWithATorqueLimit) {
+  ASSERT_EQ(run("tune table-5.1 -o pi.json").status, 0);
+  const Result r = run("simulate --plant table-5.1 --controller pi.json --test load-step --amplitude 4 "
+                       "--torque-limit 5 --duration 40 -o load.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("peak deviation"), std::string::npos) << r.out;
+  // A load torque of 4 N m above the load's stiction 3 N m: at rest again the motor holds it
+  // against the Coulomb level, |u| within the limit everywhere.
+  std::istringstream in(slurp(path("load.csv")));
+  std::string line;
+  std::getline(in, line);
+  std::getline(in, line);
+  double peak = 0.0;
+  while (std::getline(in, line)) {
+    std::istringstream row(line);
+    std::string cell;
+    for (int c = 0; c < 4; ++c) std::getline(row, cell, ',');
+    peak = std::max(peak, std::abs(std::stod(cell)));
+  }
+  EXPECT_LE(peak, 5.0);
+}
+
+TEST_F(Cli, SimulateExplainsWhatItCannotRun) {
+  write("frf.csv", e10_csv(40));
+  ASSERT_EQ(run("fit frf.csv --model two-mass -o pm.json").status, 0);
+  ASSERT_EQ(run("tune pm.json -o pi.json").status, 0);
+  Result r = run("simulate --controller pi.json");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("--plant"), std::string::npos) << r.err;
+  write("tf.json", R"({"format": "servotwin.plant/1", "type": "transfer-function", "num": [1, 0.02, 1],
+                       "den": [1, 0.18, 9, 0], "noise_std": 0, "ts": 0.01})");
+  r = run("simulate --plant tf.json --controller pi.json --test load-step");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("load-torque input"), std::string::npos) << r.err;
+  r = run("simulate --plant table-5.1 --controller pi.json --amplitude -1");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("amplitude"), std::string::npos) << r.err;
+  EXPECT_EQ(run("simulate --plant table-5.1 --controller pi.json --test ramp").status, 2);
+  ASSERT_EQ(run("simulate --plant table-5.1 --controller pi.json --duration 1 -o s.csv").status, 0);
+  r = run("simulate --plant table-5.1 --controller pi.json --duration 1 -o s.csv");
+  EXPECT_EQ(r.status, 3);  // never replaces an existing file without --force
+}
+
+}  // namespace
+}  // namespace servotwin::cli_test

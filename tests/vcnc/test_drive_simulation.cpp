@@ -1,0 +1,248 @@
+// Closed-loop verification of tuned controllers on the machine plant (issue 7 §5).
+// References: on a plant without nonlinearities the sampled loop must reproduce the continuous
+// closed-loop step responses of tuning::VelocityLoop / position_closed_loop (rational transfer
+// functions composed independently of the simulation, sampled by core::step_response) to within
+// the discretization error O(ts); static equilibria in closed form (integral action: the torque
+// settles at the load torque, or at the Coulomb level at constant velocity); the plant's sign
+// convention for the load torque (it opposes the motion, as in the dissertation).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <string>
+
+#include "servotwin/core/error.hpp"
+#include "servotwin/core/state_space.hpp"
+#include "servotwin/fit/plant_model.hpp"
+#include "servotwin/machine/flexible_plant.hpp"
+#include "servotwin/tuning/position_loop.hpp"
+#include "servotwin/tuning/tune.hpp"
+#include "servotwin/tuning/velocity_loop.hpp"
+#include "servotwin/vcnc/drive_simulation.hpp"
+
+namespace servotwin::vcnc {
+namespace {
+
+constexpr double kTs = 2e-3;
+
+/// A two-mass plant already in normalized units: Im = 1, ωz = sqrt(k/Il) = 1, r = sqrt(1 + Il/Im) = 2,
+/// shaft damping for ζz = b/(2 sqrt(k Il)) = 0.02.
+machine::PlantConfig normalized_plant() {
+  machine::PlantConfig p;
+  p.name = "normalized two-mass";
+  p.model = machine::two_mass(1.0, 3.0, 3.0, 0.12);
+  p.settings.ts = kTs;
+  return p;
+}
+
+tuning::TuneResult tuned(const machine::PlantConfig& plant, tuning::Structure structure) {
+  const auto tf = machine::mass_chain_transfer_function(std::get<machine::MassChain>(plant.model),
+                                                        machine::PlantOutput::MotorVelocity);
+  tuning::TuneOptions o;
+  o.structure = structure;
+  return tuning::tune(fit::plant_model_from_transfer_function(tf), o);
+}
+
+/// The continuous closed loop of the design (no HF dynamics: the sampled loop adds only ~ts/2).
+tuning::ClosedLoopTransfer continuous_loop(const tuning::TuneResult& r) {
+  return tuning::VelocityLoop(r.plant, r.controller.normalized, false).closed_loop();
+}
+
+template <class Get>
+double max_difference(const std::vector<DriveSample>& sim, const std::vector<double>& reference, Get get) {
+  double worst = 0.0;
+  for (std::size_t k = 0; k < sim.size() && k < reference.size(); ++k)
+    worst = std::max(worst, std::abs(get(sim[k]) - reference[k]));
+  return worst;
+}
+
+TEST(DriveSimulation, VelocityStepOnTheLinearPlantFollowsTheContinuousLoop) {
+  const auto plant = normalized_plant();
+  const auto r = tuned(plant, tuning::Structure::kPi);
+  ASSERT_NEAR(r.controller.plant.omega_z, 1.0, 1e-9);  // normalized = physical for this plant
+  ASSERT_NEAR(r.controller.plant.motor_inertia, 1.0, 1e-9);
+  DriveSimulationSettings s;
+  s.duration_s = 30.0;
+  const DriveSimulation sim = simulate_drive(plant, r.controller, s);
+  ASSERT_EQ(sim.samples.size(), 15001U);
+  const auto loop = continuous_loop(r);
+  const auto load = core::step_response(*loop.load_tracking, kTs, sim.samples.size());
+  const auto motor = core::step_response(loop.motor_tracking, kTs, sim.samples.size());
+  EXPECT_LT(max_difference(sim.samples, load, [](const DriveSample& x) { return x.load_velocity; }), 5e-3);
+  EXPECT_LT(max_difference(sim.samples, motor, [](const DriveSample& x) { return x.motor_velocity; }), 5e-3);
+  // Nothing nonlinear in this plant: the run and its linear twin are the same.
+  for (std::size_t k = 0; k < sim.samples.size(); k += 997)
+    EXPECT_DOUBLE_EQ(sim.samples[k].load_velocity, sim.linear_samples[k].load_velocity);
+  // The metrics agree with the tuner's continuous analysis of the same loop.
+  EXPECT_NEAR(sim.metrics.overshoot, r.controller.predicted.overshoot, 5e-3);
+  EXPECT_NEAR(sim.metrics.settling_time, r.controller.predicted.settling_time, 0.05 * r.controller.predicted.settling_time);
+  EXPECT_NEAR(sim.metrics.final_error, 0.0, 1e-4);
+  EXPECT_TRUE(sim.notes.empty()) << sim.notes.front();
+}
+
+TEST(DriveSimulation, LoadStepFollowsTheContinuousLoopAndSettlesAtTheLoadTorque) {
+  const auto plant = normalized_plant();
+  const auto r = tuned(plant, tuning::Structure::kPi);
+  DriveSimulationSettings s;
+  s.test = DriveTest::kLoadStep;
+  s.amplitude = 0.5;
+  s.duration_s = 40.0;
+  const DriveSimulation sim = simulate_drive(plant, r.controller, s);
+  const auto loop = continuous_loop(r);
+  auto load = core::step_response(*loop.load_from_load_torque, kTs, sim.samples.size());
+  for (double& v : load) v *= s.amplitude;
+  const double peak = *std::max_element(load.begin(), load.end(), [](double a, double b) { return std::abs(a) < std::abs(b); });
+  ASSERT_LT(peak, 0.0);  // Tl opposes the motion: the load is pushed backwards
+  EXPECT_LT(max_difference(sim.samples, load, [](const DriveSample& x) { return x.load_velocity; }), 5e-3 * std::abs(peak));
+  EXPECT_NEAR(sim.metrics.peak_deviation, std::abs(peak), 5e-3 * std::abs(peak));
+  // Integral action: at rest again, the motor torque balances the load torque exactly.
+  EXPECT_NEAR(sim.samples.back().torque_command, s.amplitude, 1e-3 * s.amplitude);
+  EXPECT_NEAR(sim.samples.back().load_velocity, 0.0, 1e-3 * std::abs(peak));
+  EXPECT_TRUE(std::isfinite(sim.metrics.recovery_time));
+}
+
+TEST(DriveSimulation, PositionStepFollowsTheContinuousCascade) {
+  const auto plant = normalized_plant();
+  const auto r = tuned(plant, tuning::Structure::kPiP);
+  ASSERT_TRUE(r.controller.kpp_physical);
+  DriveSimulationSettings s;
+  s.duration_s = 60.0;
+  const DriveSimulation sim = simulate_drive(plant, r.controller, s);
+  const auto cascade = tuning::position_closed_loop(continuous_loop(r), *r.controller.kpp_normalized);
+  const auto load = core::step_response(cascade.load_tracking, kTs, sim.samples.size());
+  EXPECT_LT(max_difference(sim.samples, load, [](const DriveSample& x) { return x.load_position; }), 5e-3);
+  EXPECT_NEAR(sim.samples.back().load_position, 1.0, 1e-3);
+}
+
+TEST(DriveSimulation, PositionLoopUnderALoadTorqueKeepsTheShaftTwist) {
+  // Motor-position feedback with integral action puts the motor back at φ* = 0; the load stays
+  // deflected by the static twist of the shaft, φl = −Tl/k = −0.5/3 (closed form).
+  const auto plant = normalized_plant();
+  const auto r = tuned(plant, tuning::Structure::kPiP);
+  DriveSimulationSettings s;
+  s.test = DriveTest::kLoadStep;
+  s.amplitude = 0.5;
+  const DriveSimulation sim = simulate_drive(plant, r.controller, s);  // automatic duration
+  EXPECT_NEAR(sim.samples.back().motor_position, 0.0, 1e-3);
+  EXPECT_NEAR(sim.samples.back().load_position, -0.5 / 3.0, 1e-3);
+  EXPECT_NEAR(sim.metrics.final_error, 0.5 / 3.0, 1e-3);
+  EXPECT_TRUE(std::isfinite(sim.metrics.recovery_time));
+  EXPECT_LT(sim.metrics.recovery_time, sim.samples.back().t);
+}
+
+TEST(DriveSimulation, IntegralActionRemovesCoulombFrictionAtConstantVelocity) {
+  auto plant = normalized_plant();
+  auto& chain = std::get<machine::MassChain>(plant.model);
+  chain.friction = {machine::KarnoppFriction{}, machine::KarnoppFriction{0.05, 0.08, 1e-3}};
+  const auto r = tuned(plant, tuning::Structure::kPi);  // designed on the linear part
+  DriveSimulationSettings s;
+  s.duration_s = 40.0;
+  const DriveSimulation sim = simulate_drive(plant, r.controller, s);
+  EXPECT_NEAR(sim.metrics.final_error, 0.0, 1e-3);
+  // Sliding at constant velocity, no viscous friction: the torque equals the Coulomb level.
+  EXPECT_NEAR(sim.samples.back().torque_command, 0.05, 1e-3);
+  EXPECT_NEAR(sim.linear_samples.back().torque_command, 0.0, 1e-3);
+}
+
+TEST(DriveSimulation, TorqueLimitIsRespectedAndTheLoopStillSettles) {
+  const auto plant = normalized_plant();
+  const auto r = tuned(plant, tuning::Structure::kPi);
+  DriveSimulationSettings s;
+  s.duration_s = 60.0;
+  const DriveSimulation free_run = simulate_drive(plant, r.controller, s);
+  s.torque_limit = 0.5 * free_run.metrics.peak_torque;
+  const DriveSimulation sim = simulate_drive(plant, r.controller, s);
+  for (const auto& x : sim.samples) ASSERT_LE(std::abs(x.torque_command), *s.torque_limit * (1.0 + 1e-12));
+  EXPECT_GT(sim.metrics.saturated_fraction, 0.0);
+  EXPECT_TRUE(std::isfinite(sim.metrics.settling_time));
+  EXPECT_NEAR(sim.metrics.final_error, 0.0, 1e-3);
+  EXPECT_DOUBLE_EQ(sim.linear_metrics.peak_torque, free_run.metrics.peak_torque);  // the twin is unlimited
+  EXPECT_FALSE(sim.notes.empty());
+}
+
+TEST(DriveSimulation, EncoderQuantizationReachesTheLoopThroughTheDifferencedPosition) {
+  auto plant = normalized_plant();
+  plant.settings.output = machine::PlantOutput::MotorPosition;
+  const double q = 2.0 * std::numbers::pi / 4096.0;
+  plant.settings.quantization = q;
+  const auto r = tuned(plant, tuning::Structure::kPi);
+  DriveSimulationSettings s;
+  s.duration_s = 30.0;
+  const DriveSimulation sim = simulate_drive(plant, r.controller, s);
+  for (std::size_t k = 0; k < sim.samples.size(); k += 101)
+    ASSERT_NEAR(std::remainder(sim.samples[k].measured, q), 0.0, 1e-9);
+  // The velocity estimate is quantized to q/ts, but its mean is the true velocity: integral action
+  // still holds the mean load velocity at the reference.
+  EXPECT_NEAR(sim.metrics.final_error, 0.0, 0.01);
+  EXPECT_GT(sim.metrics.residual_oscillation, 10.0 * sim.linear_metrics.residual_oscillation);
+}
+
+TEST(DriveSimulation, LinearPartDropsExactlyTheNonlinearElements) {
+  auto plant = normalized_plant();
+  auto& chain = std::get<machine::MassChain>(plant.model);
+  chain.friction = {machine::KarnoppFriction{0.1, 0.2, 0.0}, machine::KarnoppFriction{}};
+  chain.backlash = {1e-3};
+  chain.viscous = {0.01, 0.02};
+  plant.settings.noise_std = 1e-3;
+  plant.settings.quantization = 1e-4;
+  plant.settings.current_lag = 1e-3;
+  plant.settings.delay_samples = 2;
+  const auto linear = linear_part(plant);
+  const auto& lc = std::get<machine::MassChain>(linear.model);
+  EXPECT_TRUE(lc.friction.empty());
+  EXPECT_TRUE(lc.backlash.empty());
+  EXPECT_EQ(lc.viscous, chain.viscous);
+  EXPECT_EQ(lc.inertia, chain.inertia);
+  EXPECT_EQ(linear.settings.noise_std, 0.0);
+  EXPECT_EQ(linear.settings.quantization, 0.0);
+  EXPECT_EQ(linear.settings.current_lag, 1e-3);
+  EXPECT_EQ(linear.settings.delay_samples, 2);
+  EXPECT_TRUE(machine::FlexiblePlant(linear).is_linear());
+}
+
+void expect_field(const std::function<void()>& f, const std::string& field) {
+  try {
+    f();
+    ADD_FAILURE() << "no InputError for " << field;
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.where().field, field) << e.what();
+  }
+}
+
+TEST(DriveSimulation, RefusesWhatItCannotRun) {
+  const auto plant = normalized_plant();
+  const auto r = tuned(plant, tuning::Structure::kPi);
+  auto load_output = plant;
+  load_output.settings.output = machine::PlantOutput::LoadVelocity;
+  expect_field([&] { (void)simulate_drive(load_output, r.controller); }, "settings.output");
+  machine::PlantConfig tf_plant;
+  tf_plant.model = machine::TransferFunctionModel{
+      core::TransferFunction(core::Polynomial{1.0}, core::Polynomial{1.0, 1.0, 0.0})};
+  tf_plant.settings.ts = kTs;
+  DriveSimulationSettings load_step;
+  load_step.test = DriveTest::kLoadStep;
+  expect_field([&] { (void)simulate_drive(tf_plant, r.controller, load_step); }, "model");
+  DriveSimulationSettings bad;
+  bad.amplitude = 0.0;
+  expect_field([&] { (void)simulate_drive(plant, r.controller, bad); }, "amplitude");
+  bad = {};
+  bad.torque_limit = -1.0;
+  expect_field([&] { (void)simulate_drive(plant, r.controller, bad); }, "torque_limit");
+  bad = {};
+  bad.duration_s = 1e6;
+  expect_field([&] { (void)simulate_drive(plant, r.controller, bad); }, "duration_s");
+  auto no_kpp = tuned(plant, tuning::Structure::kPiP).controller;
+  no_kpp.kpp_physical.reset();
+  expect_field([&] { (void)simulate_drive(plant, no_kpp); }, "controller.kpp_physical");
+}
+
+TEST(DriveSimulation, TestNamesRoundTrip) {
+  for (const DriveTest t : {DriveTest::kSetpointStep, DriveTest::kLoadStep})
+    EXPECT_EQ(drive_test_from_string(to_string(t)), t);
+  EXPECT_FALSE(drive_test_from_string("ramp"));
+}
+
+}  // namespace
+}  // namespace servotwin::vcnc
