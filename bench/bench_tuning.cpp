@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "servotwin/fit/plant_model.hpp"
+#include "servotwin/tuning/lqg.hpp"
 #include "servotwin/tuning/normalized_plant.hpp"
 #include "servotwin/tuning/pi_design.hpp"
 #include "servotwin/tuning/robustness.hpp"
@@ -142,5 +143,27 @@ void BM_TuneAutomatic(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_TuneAutomatic)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
+
+/// One LQG design (two 4x4 or 5x5 Riccati solves, the compensator and every pole set): the inner
+/// step of a kbw search, so it should stay well under a millisecond.
+void BM_LqgDesign(benchmark::State& state) {
+  const bool position = state.range(0) == 1;
+  const FrictionTwoMass plant{8.0, 8.0, 0.16, 0.01, 0.02};  // r = 3, zeta_z = 0.01 (E29) with friction
+  double kbw = 1.0;
+  for (auto _ : state) {
+    if (position) {
+      PositionLqgOptions o;
+      o.kbw = kbw;
+      benchmark::DoNotOptimize(position_lqg(plant, 3.0, o));
+    } else {
+      VelocityLqgOptions o;
+      o.kbw = kbw;
+      benchmark::DoNotOptimize(velocity_lqg(plant, 3.0, o));
+    }
+    kbw += 1e-9;
+  }
+  state.SetLabel(position ? "position" : "velocity");
+}
+BENCHMARK(BM_LqgDesign)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -1,0 +1,82 @@
+#pragma once
+/// \file
+/// LQG velocity and position compensators for the normalized two-mass plant with the weighting
+/// scheme of the dissertation (catalog C7.13, example E29): one design knob kbw, weights scaled by
+/// c = r²/2 so that the same kbw gives comparable loops for any resonance ratio.
+///
+/// Plant (normalized: Im = 1, ωz = 1; FrictionTwoMass), the load torque Tl opposing the motion:
+///   ω̇m = −(b + bm) ωm + b ωl − Ts + Tm,   Il ω̇l = b ωm − (b + bl) ωl + Ts − Tl,   Ṫs = k (ωm − ωl).
+///
+/// Velocity LQG. Regulator on x = [ωm, ωl, Ts, xi] with xi' = ω* − ωm (integral action),
+/// Q = diag(0, q_load, kbw/c², q_integral), R = ρ = kbw/c² (printed q_load = q_integral = 20;
+/// a larger kbw makes control dearer: a slower loop). Kalman filter on [ωm, ωl, Ts, Tl] with a
+/// constant load torque, y = ωm, process noise into ωm and Tl with intensities W = diag(wm, wt)
+/// (printed 1, 1), measurement noise V (printed 0.1). The integral state is not estimated.
+/// Compensator (5 states [x̂, xi], inputs [ω*, ωm], output u):
+///   u = −K₁ x̂₁ − K₂ x̂₂ − K₃ x̂₃ − K₄ xi + kff ω*   (x̂₁ replaced by the measured ωm with
+///   raw_motor_velocity), x̂' = Ae x̂ + Be u + L (ωm − x̂₁), xi' = ω* − ωm.
+///
+/// Position LQG. Regulator on [φm, ωm, φl, ωl, xi], xi' = φ* − φm, Q = diag(1, 1, 20, 20, 5),
+/// R = kbw/c²; Kalman filter on [φm, ωm, φl, ωl, Tl] (the estimator model, eq. 7.138, is missing
+/// from the source, defect 19: the position model plus a constant load torque), y = φm, W = I₅,
+/// V = 0.01. Compensator (6 states, inputs [φ*, φm]).
+///
+/// An LQG compensator is often unstable itself (the regulator pushes against the lightly damped
+/// pair and the estimator's copy of it): the design reports the compensator's poles and whether
+/// it is stable, as a drive commissioner must know before switching it on.
+
+#include <complex>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "servotwin/core/state_space.hpp"
+#include "servotwin/tuning/normalized_plant.hpp"
+
+namespace servotwin::tuning {
+
+/// Velocity-LQG weights (C7.13; defaults as printed).
+struct VelocityLqgOptions {
+  double kbw = 1.0;                 ///< bandwidth knob (> 0): larger = slower
+  double q_load_velocity = 20.0;    ///< Q weight of ωl
+  double q_integral = 20.0;         ///< Q weight of the integral state
+  double noise_motor = 1.0;         ///< process-noise intensity into ωm
+  double noise_load_torque = 1.0;   ///< process-noise intensity into the load torque
+  double measurement_noise = 0.1;   ///< V
+  double feedforward = 0.0;         ///< kff: ω* straight to the torque (normalized)
+  bool raw_motor_velocity = false;  ///< regulate ωm with the measurement instead of its estimate
+};
+
+/// Position-LQG weights (C7.13; defaults as printed).
+struct PositionLqgOptions {
+  double kbw = 1.0;
+  Eigen::Matrix<double, 5, 1> q = (Eigen::Matrix<double, 5, 1>() << 1.0, 1.0, 20.0, 20.0, 5.0).finished();  ///< diag of Q
+  double process_noise = 1.0;      ///< W = process_noise · I₅
+  double measurement_noise = 0.01; ///< V
+};
+
+/// A designed LQG compensator (normalized units).
+struct LqgDesign {
+  Eigen::RowVectorXd regulator_gain;  ///< K (u = −K x)
+  Eigen::VectorXd estimator_gain;     ///< L
+  std::vector<std::complex<double>> regulator_poles;   ///< eig(A − B K)
+  std::vector<std::complex<double>> estimator_poles;   ///< eig(Ae − L Ce)
+  std::vector<std::complex<double>> controller_poles;  ///< eig of the compensator
+  std::vector<std::complex<double>> closed_loop_poles; ///< plant + compensator (separation: regulator ∪ estimator)
+  bool controller_stable = false;     ///< every compensator pole in the open left half-plane (the integrator excepted)
+  core::StateSpace compensator;       ///< inputs [reference, measurement], output u
+  double riccati_residual = 0.0;      ///< the larger relative residual of the two Riccati solves
+};
+
+/// The normalized plant as a state space with inputs [Tm, Tl] and outputs [ωm, ωl] (velocity:
+/// states [ωm, ωl, Ts]) or [φm, φl] (position: states [φm, ωm, φl, ωl]).
+[[nodiscard]] core::StateSpace two_mass_state_space(const FrictionTwoMass& plant, bool position);
+
+/// The velocity LQG of C7.13. core::InputError (field named after the option) for weights that are
+/// not finite and > 0 (kff, q >= 0), or a plant without stiffness.
+[[nodiscard]] LqgDesign velocity_lqg(const FrictionTwoMass& plant, double r, const VelocityLqgOptions& options = {});
+
+/// The position LQG of C7.13 (field names as above).
+[[nodiscard]] LqgDesign position_lqg(const FrictionTwoMass& plant, double r, const PositionLqgOptions& options = {});
+
+}  // namespace servotwin::tuning

@@ -1,0 +1,233 @@
+#include "servotwin/tuning/lqg.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "checks.hpp"
+#include "servotwin/core/error.hpp"
+#include "servotwin/core/riccati.hpp"
+
+namespace servotwin::tuning {
+
+namespace {
+
+using Complex = std::complex<double>;
+using Matrix = Eigen::MatrixXd;
+
+/// A controller pole counts as stable within this margin of the imaginary axis (relative to the
+/// largest pole): the integrator's pole at 0 is the only one expected there.
+constexpr double kImaginaryAxisTolerance = 1e-9;
+
+std::vector<Complex> poles_of(const Matrix& a) {
+  const Eigen::VectorXcd e = a.eigenvalues();
+  std::vector<Complex> out(e.data(), e.data() + e.size());
+  std::sort(out.begin(), out.end(), [](Complex x, Complex y) {
+    if (std::abs(std::abs(x) - std::abs(y)) > 1e-12 * std::max(1.0, std::abs(x))) return std::abs(x) < std::abs(y);
+    return x.imag() > y.imag();
+  });
+  return out;
+}
+
+bool stable_except_integrator(const std::vector<Complex>& poles) {
+  double scale = 1.0;
+  for (const Complex p : poles) scale = std::max(scale, std::abs(p));
+  bool integrator_seen = false;
+  for (const Complex p : poles) {
+    if (std::abs(p) <= kImaginaryAxisTolerance * scale && !integrator_seen) {
+      integrator_seen = true;  // the integral state of the compensator
+      continue;
+    }
+    if (p.real() >= -kImaginaryAxisTolerance * scale) return false;
+  }
+  return true;
+}
+
+void check_plant(const FrictionTwoMass& p, double r) {
+  detail::require_positive(p.stiffness, "stiffness", "a shaft stiffness");
+  detail::require_positive(p.load_inertia, "load_inertia", "a load inertia");
+  detail::require_ratio(r, "r");
+  detail::require_non_negative(p.damping, "damping", "a shaft damping");
+  detail::require_non_negative(p.motor_viscous, "motor_viscous", "a viscous friction");
+  detail::require_non_negative(p.load_viscous, "load_viscous", "a viscous friction");
+}
+
+/// ρ = kbw/c² with c = r²/2 (C7.13).
+double control_weight(double kbw, double r) {
+  const double c = r * r / 2.0;
+  return kbw / (c * c);
+}
+
+/// The regulator gain K = R⁻¹ Bᵀ X of the CARE (scalar input).
+Eigen::RowVectorXd regulator(const Matrix& a, const Matrix& b, const Matrix& q, double rho, double& residual) {
+  core::CareReport report;
+  const Matrix x = core::solve_care(a, b, q, Matrix::Constant(1, 1, rho), &report);
+  residual = std::max(residual, report.relative_residual);
+  return (b.transpose() * x).row(0) / rho;
+}
+
+/// The Kalman gain L = Y Cᵀ V⁻¹ of the filter CARE (scalar output).
+Eigen::VectorXd estimator(const Matrix& a, const Matrix& c, const Matrix& w, double v, double& residual) {
+  core::CareReport report;
+  const Matrix y = core::solve_care_filter(a, c, w, Matrix::Constant(1, 1, v), &report);
+  residual = std::max(residual, report.relative_residual);
+  return (y * c.transpose()).col(0) / v;
+}
+
+/// Plant + compensator closed loop (reference and load torque set to zero): its poles.
+std::vector<Complex> closed_loop_poles(const core::StateSpace& plant, const core::StateSpace& c) {
+  // Plant x' = A x + Bu u (+ Bt Tl), y = C₀ x (first output); u = Cc xc + Dc [r, y].
+  const Eigen::Index n = plant.A.rows(), m = c.A.rows();
+  const Matrix bu = plant.B.col(0);
+  const Matrix cy = plant.C.row(0);
+  Matrix a(n + m, n + m);
+  a.topLeftCorner(n, n) = plant.A + bu * c.D(0, 1) * cy;
+  a.topRightCorner(n, m) = bu * c.C;
+  a.bottomLeftCorner(m, n) = c.B.col(1) * cy;
+  a.bottomRightCorner(m, m) = c.A;
+  return poles_of(a);
+}
+
+/// The estimator's model: the plant's states plus a constant load torque, input Tm, output y.
+struct EstimatorModel {
+  Matrix a, b, c;
+};
+EstimatorModel estimator_model(const core::StateSpace& p) {
+  const Eigen::Index n = p.A.rows();
+  EstimatorModel e{Matrix::Zero(n + 1, n + 1), Matrix::Zero(n + 1, 1), Matrix::Zero(1, n + 1)};
+  e.a.topLeftCorner(n, n) = p.A;
+  e.a.block(0, n, n, 1) = p.B.col(1);
+  e.b.topRows(n) = p.B.col(0);
+  e.c.leftCols(n) = p.C.row(0);
+  return e;
+}
+
+/// Regulator on the plant's states plus the integral of −y (xi' = reference − y at run time) and
+/// estimator on the plant's states plus a constant load torque (y = first output); the design's
+/// gains and pole sets. `q` is the diagonal of Q over [plant states, xi]; `w` the process-noise
+/// intensity over [plant states, Tl].
+LqgDesign regulator_and_estimator(const core::StateSpace& p, const Eigen::VectorXd& q, double rho, const Matrix& w,
+                                  double v) {
+  const Eigen::Index n = p.A.rows();
+  LqgDesign d;
+  Matrix a = Matrix::Zero(n + 1, n + 1);
+  a.topLeftCorner(n, n) = p.A;
+  a.bottomLeftCorner(1, n) = -p.C.row(0);
+  Matrix b = Matrix::Zero(n + 1, 1);
+  b.topRows(n) = p.B.col(0);
+  d.regulator_gain = regulator(a, b, q.asDiagonal().toDenseMatrix(), rho, d.riccati_residual);
+  d.regulator_poles = poles_of(a - b * d.regulator_gain);
+  const EstimatorModel e = estimator_model(p);
+  d.estimator_gain = estimator(e.a, e.c, w, v, d.riccati_residual);
+  d.estimator_poles = poles_of(e.a - d.estimator_gain * e.c);
+  return d;
+}
+
+/// The compensator with states [x̂ (plant + Tl), xi], inputs [reference, y], output
+///   u = −kx x̂ − K_xi xi − ky y + kref·reference,
+/// x̂' = Ae x̂ + Be u + L (y − Ce x̂), xi' = reference − y; its poles and the closed loop's.
+void finish(LqgDesign& d, const core::StateSpace& p, const Eigen::RowVectorXd& kx, double ky, double kref) {
+  const Eigen::Index ne = p.A.rows() + 1;
+  const EstimatorModel e = estimator_model(p);
+  const Matrix& ae = e.a;
+  const Matrix& be = e.b;
+  const Matrix& ce = e.c;
+  const double k_xi = d.regulator_gain(ne - 1);
+  core::StateSpace& c = d.compensator;
+  c.A = Matrix::Zero(ne + 1, ne + 1);
+  c.A.topLeftCorner(ne, ne) = ae - be * kx - d.estimator_gain * ce;
+  c.A.block(0, ne, ne, 1) = -be * k_xi;
+  c.B = Matrix::Zero(ne + 1, 2);
+  c.B.block(0, 0, ne, 1) = be * kref;
+  c.B.block(0, 1, ne, 1) = d.estimator_gain - be * ky;
+  c.B(ne, 0) = 1.0;
+  c.B(ne, 1) = -1.0;
+  c.C = Matrix::Zero(1, ne + 1);
+  c.C.leftCols(ne) = -kx;
+  c.C(0, ne) = -k_xi;
+  c.D.resize(1, 2);
+  c.D << kref, -ky;
+  d.controller_poles = poles_of(c.A);
+  d.controller_stable = stable_except_integrator(d.controller_poles);
+  d.closed_loop_poles = closed_loop_poles(p, c);
+}
+
+}  // namespace
+
+core::StateSpace two_mass_state_space(const FrictionTwoMass& p, bool position) {
+  const double il = p.load_inertia, k = p.stiffness, b = p.damping, bm = p.motor_viscous, bl = p.load_viscous;
+  core::StateSpace s;
+  if (!position) {
+    s.A.resize(3, 3);
+    s.A << -(b + bm), b, -1.0,  //
+        b / il, -(b + bl) / il, 1.0 / il,  //
+        k, -k, 0.0;
+    s.B.setZero(3, 2);
+    s.B(0, 0) = 1.0;
+    s.B(1, 1) = -1.0 / il;
+    s.C.setZero(2, 3);
+    s.C(0, 0) = 1.0;
+    s.C(1, 1) = 1.0;
+  } else {
+    s.A.resize(4, 4);
+    s.A << 0.0, 1.0, 0.0, 0.0,  //
+        -k, -(b + bm), k, b,  //
+        0.0, 0.0, 0.0, 1.0,  //
+        k / il, b / il, -k / il, -(b + bl) / il;
+    s.B.setZero(4, 2);
+    s.B(1, 0) = 1.0;
+    s.B(3, 1) = -1.0 / il;
+    s.C.setZero(2, 4);
+    s.C(0, 0) = 1.0;
+    s.C(1, 2) = 1.0;
+  }
+  s.D.setZero(2, 2);
+  return s;
+}
+
+LqgDesign velocity_lqg(const FrictionTwoMass& plant, double r, const VelocityLqgOptions& o) {
+  check_plant(plant, r);
+  detail::require_positive(o.kbw, "kbw", "the LQG bandwidth knob");
+  detail::require_positive(o.measurement_noise, "measurement_noise", "a measurement-noise intensity");
+  detail::require_non_negative(o.q_load_velocity, "q_load_velocity");
+  detail::require_non_negative(o.q_integral, "q_integral");
+  detail::require_non_negative(o.noise_motor, "noise_motor");
+  detail::require_non_negative(o.noise_load_torque, "noise_load_torque");
+  detail::require_non_negative(o.feedforward, "feedforward");
+
+  const core::StateSpace p = two_mass_state_space(plant, false);
+  const double rho = control_weight(o.kbw, r);
+  Matrix w = Matrix::Zero(4, 4);
+  w(0, 0) = o.noise_motor;
+  w(3, 3) = o.noise_load_torque;
+  LqgDesign d = regulator_and_estimator(p, Eigen::Vector4d(0.0, o.q_load_velocity, rho, o.q_integral), rho, w,
+                                        o.measurement_noise);
+  // u = −K₁ x̂₁ − K₂ x̂₂ − K₃ x̂₃ − K₄ xi + kff ω* (K₁ on the measurement with raw_motor_velocity).
+  Eigen::RowVectorXd kx = Eigen::RowVectorXd::Zero(4);
+  kx.head(3) = d.regulator_gain.head(3);
+  double ky = 0.0;
+  if (o.raw_motor_velocity) std::swap(ky, kx(0));
+  finish(d, p, kx, ky, o.feedforward);
+  return d;
+}
+
+LqgDesign position_lqg(const FrictionTwoMass& plant, double r, const PositionLqgOptions& o) {
+  check_plant(plant, r);
+  detail::require_positive(o.kbw, "kbw", "the LQG bandwidth knob");
+  detail::require_positive(o.measurement_noise, "measurement_noise", "a measurement-noise intensity");
+  detail::require_positive(o.process_noise, "process_noise", "a process-noise intensity");
+  for (Eigen::Index i = 0; i < 5; ++i) detail::require_non_negative(o.q(i), "q");
+
+  const core::StateSpace p = two_mass_state_space(plant, true);
+  const double rho = control_weight(o.kbw, r);
+  LqgDesign d = regulator_and_estimator(p, o.q, rho, o.process_noise * Matrix::Identity(5, 5), o.measurement_noise);
+  // Error coordinates: u = −K₁(φ̂m − φ*) − K₂ ω̂m − K₃(φ̂l − φ*) − K₄ ω̂l − K₅ xi, so that a step of φ*
+  // acts at once and the integral only removes what the load torque leaves.
+  Eigen::RowVectorXd kx = Eigen::RowVectorXd::Zero(5);
+  kx.head(4) = d.regulator_gain.head(4);
+  finish(d, p, kx, 0.0, d.regulator_gain(0) + d.regulator_gain(2));
+  return d;
+}
+
+}  // namespace servotwin::tuning

@@ -1,0 +1,182 @@
+// LQG velocity and position compensators (C7.13). References: E29's derived numbers in the catalog
+// (K ≈ [6.218, 21.318, −0.028, −20.125], LQR pole magnitudes 0.93 and 4.81, Kalman poles
+// −1.382 ± 2.446j and −0.496 ± 0.394j; dominant pole magnitudes 0.99 / 0.93 / 0.69 for kbw = 0.1 / 1
+// / 10); tests/data/tuning/lqg_reference.json from tools/reference/tuning_lqg_reference.py (models
+// written out in numpy, scipy.linalg.solve_continuous_are); the separation principle; the
+// closed loop's static gains in closed form.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <vector>
+
+#include "fixture.hpp"
+#include "json_fixture.hpp"
+#include "servotwin/tuning/lqg.hpp"
+
+namespace servotwin::tuning {
+namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace lqg_test {
+
+const nlohmann::json& lqg_reference() {
+  static const nlohmann::json j = test_support::read_json_fixture("tuning/lqg_reference.json", "tuning_lqg_reference.py");
+  return j;
+}
+
+/// The normalized two-mass plant of C7.13: Il = k = r² − 1, b = 2 ζz (r² − 1).
+FrictionTwoMass normalized(double r, double zeta_z, double bm = 0.0, double bl = 0.0) {
+  const double f = r * r - 1.0;
+  return {f, f, 2.0 * zeta_z * f, bm, bl};
+}
+
+std::vector<std::complex<double>> roots_of(const nlohmann::json& pairs) {
+  std::vector<std::complex<double>> v;
+  for (const auto& p : pairs) v.push_back(test::root_of(p));
+  return test::sorted_roots(v);
+}
+
+void expect_same_roots(const std::vector<std::complex<double>>& got, const std::vector<std::complex<double>>& want,
+                       double tol, const char* what) {
+  ASSERT_EQ(got.size(), want.size()) << what;
+  const auto a = test::sorted_roots(got), b = test::sorted_roots(want);
+  for (std::size_t i = 0; i < a.size(); ++i)
+    EXPECT_LT(std::abs(a[i] - b[i]), tol * std::max(1.0, std::abs(b[i]))) << what << " " << i << ": " << a[i] << " vs " << b[i];
+}
+
+TEST(Lqg, VelocityDesignReproducesE29) {
+  const LqgDesign d = velocity_lqg(normalized(3.0, 0.01), 3.0);
+  const double k[] = {6.218, 21.318, -0.028, -20.125};  // catalog E29 [D]
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(d.regulator_gain(i), k[i], 1e-3) << i;
+  std::vector<double> mags;
+  for (const auto p : d.regulator_poles) mags.push_back(std::abs(p));
+  std::sort(mags.begin(), mags.end());
+  EXPECT_NEAR(mags.front(), 0.93, 0.005);
+  EXPECT_NEAR(mags.back(), 4.81, 0.005);
+  const auto dominant = d.regulator_poles.front();
+  EXPECT_NEAR(-dominant.real() / std::abs(dominant), 0.54, 0.005);
+  expect_same_roots(d.estimator_poles, {{-1.382, 2.446}, {-1.382, -2.446}, {-0.496, 0.394}, {-0.496, -0.394}}, 1e-3,
+                    "E29 Kalman poles");
+  // The E29 compensator is itself unstable (a pole pair at 0.33 ± 1.74j): the design says so.
+  EXPECT_FALSE(d.controller_stable);
+  EXPECT_LT(d.riccati_residual, 1e-10);
+}
+
+TEST(Lqg, LargerKbwMeansASlowerLoop) {
+  // C7.13 [D]: dominant LQR pole magnitude ≈ 0.99, 0.93, 0.69 for kbw = 0.1, 1, 10 (r = 3, ζz = 0.01).
+  const double expected[] = {0.99, 0.93, 0.69};
+  const double kbw[] = {0.1, 1.0, 10.0};
+  for (int i = 0; i < 3; ++i) {
+    VelocityLqgOptions o;
+    o.kbw = kbw[i];
+    const LqgDesign d = velocity_lqg(normalized(3.0, 0.01), 3.0, o);
+    EXPECT_NEAR(std::abs(d.regulator_poles.front()), expected[i], 0.006) << "kbw " << kbw[i];
+  }
+}
+
+TEST(Lqg, VelocityDesignsMatchScipy) {
+  for (const auto& c : lqg_reference().at("velocity")) {
+    const double r = c.at("r");
+    VelocityLqgOptions o;
+    o.kbw = c.at("kbw");
+    o.raw_motor_velocity = c.at("raw_motor_velocity");
+    const LqgDesign d = velocity_lqg(normalized(r, c.at("zeta_z"), c.at("bm"), c.at("bl")), r, o);
+    SCOPED_TRACE("r = " + std::to_string(r) + ", kbw = " + std::to_string(o.kbw) + (o.raw_motor_velocity ? ", raw" : ""));
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_NEAR(d.regulator_gain(i), c.at("K").at(i).get<double>(), 1e-7 * std::max(1.0, std::abs(d.regulator_gain(i))));
+      EXPECT_NEAR(d.estimator_gain(i), c.at("L").at(i).get<double>(), 1e-7 * std::max(1.0, std::abs(d.estimator_gain(i))));
+    }
+    expect_same_roots(d.regulator_poles, roots_of(c.at("lqr_poles")), 1e-7, "regulator");
+    expect_same_roots(d.estimator_poles, roots_of(c.at("kf_poles")), 1e-7, "estimator");
+    expect_same_roots(d.controller_poles, roots_of(c.at("controller_poles")), 1e-6, "controller");
+    expect_same_roots(d.closed_loop_poles, roots_of(c.at("closed_loop_poles")), 1e-6, "closed loop");
+    const auto& m = c.at("compensator");
+    for (Eigen::Index i = 0; i < 5; ++i)
+      for (Eigen::Index j = 0; j < 5; ++j)
+        EXPECT_NEAR(d.compensator.A(i, j), m.at("A").at(i).at(j).get<double>(), 1e-6 * std::max(1.0, std::abs(d.compensator.A(i, j))));
+  }
+}
+
+TEST(Lqg, ClosedLoopPolesAreRegulatorAndEstimatorPoles) {
+  // Separation principle: with the estimate in the feedback the closed loop has exactly the
+  // regulator's and the estimator's poles.
+  for (const double r : {1.6, 3.0, 6.0}) {
+    const LqgDesign v = velocity_lqg(normalized(r, 0.02, 0.01, 0.02), r);
+    std::vector<std::complex<double>> both = v.regulator_poles;
+    both.insert(both.end(), v.estimator_poles.begin(), v.estimator_poles.end());
+    expect_same_roots(v.closed_loop_poles, both, 1e-6, "velocity");
+    const LqgDesign p = position_lqg(normalized(r, 0.02, 0.01, 0.02), r);
+    both = p.regulator_poles;
+    both.insert(both.end(), p.estimator_poles.begin(), p.estimator_poles.end());
+    expect_same_roots(p.closed_loop_poles, both, 1e-6, "position");
+  }
+}
+
+/// Static gain from the compensator's reference input to plant output `out` under a load torque
+/// `tl` (solves the closed loop's equilibrium A x + B_ref + B_load tl = 0 directly).
+double static_output(const LqgDesign& d, const core::StateSpace& plant, int out, double reference, double tl) {
+  const core::StateSpace& c = d.compensator;
+  const Eigen::Index n = plant.A.rows(), m = c.A.rows();
+  Eigen::MatrixXd a(n + m, n + m);
+  const Eigen::MatrixXd bu = plant.B.col(0), cy = plant.C.row(0);
+  a.topLeftCorner(n, n) = plant.A + bu * c.D(0, 1) * cy;
+  a.topRightCorner(n, m) = bu * c.C;
+  a.bottomLeftCorner(m, n) = c.B.col(1) * cy;
+  a.bottomRightCorner(m, m) = c.A;
+  Eigen::VectorXd f(n + m);
+  f.head(n) = bu * c.D(0, 0) * reference + plant.B.col(1) * tl;
+  f.tail(m) = c.B.col(0) * reference;
+  const Eigen::VectorXd x = a.fullPivLu().solve(-f);
+  return (plant.C.row(out) * x.head(n))(0);
+}
+
+TEST(Lqg, IntegralActionGivesUnitStaticGainsAndRejectsLoadTorque) {
+  const FrictionTwoMass plant = normalized(2.5, 0.02, 0.01, 0.03);
+  VelocityLqgOptions vo;
+  vo.feedforward = 0.7;
+  const LqgDesign v = velocity_lqg(plant, 2.5, vo);
+  const core::StateSpace pv = two_mass_state_space(plant, false);
+  EXPECT_NEAR(static_output(v, pv, 0, 1.0, 0.0), 1.0, 1e-9);  // ωm → ω*
+  EXPECT_NEAR(static_output(v, pv, 1, 1.0, 0.0), 1.0, 1e-9);  // and ωl with it (rigid at DC)
+  EXPECT_NEAR(static_output(v, pv, 1, 0.0, 0.4), 0.0, 1e-9);  // a constant load torque leaves no speed error
+  const LqgDesign p = position_lqg(plant, 2.5);
+  const core::StateSpace pp = two_mass_state_space(plant, true);
+  EXPECT_NEAR(static_output(p, pp, 0, 1.0, 0.0), 1.0, 1e-9);  // φm → φ*
+  EXPECT_NEAR(static_output(p, pp, 1, 1.0, 0.0), 1.0, 1e-9);  // φl too: no torque, no twist
+  // Under a load torque the motor is held at φ* and the load keeps the static twist −Tl/k.
+  EXPECT_NEAR(static_output(p, pp, 0, 0.0, 0.4), 0.0, 1e-9);
+  EXPECT_NEAR(static_output(p, pp, 1, 0.0, 0.4), -0.4 / plant.stiffness, 1e-9);
+}
+
+TEST(Lqg, PositionDesignsMatchScipy) {
+  for (const auto& c : lqg_reference().at("position")) {
+    const double r = c.at("r");
+    PositionLqgOptions o;
+    o.kbw = c.at("kbw");
+    const LqgDesign d = position_lqg(normalized(r, c.at("zeta_z"), c.at("bm"), c.at("bl")), r, o);
+    for (int i = 0; i < 5; ++i) {
+      EXPECT_NEAR(d.regulator_gain(i), c.at("K").at(i).get<double>(), 1e-7 * std::max(1.0, std::abs(d.regulator_gain(i))));
+      EXPECT_NEAR(d.estimator_gain(i), c.at("L").at(i).get<double>(), 1e-7 * std::max(1.0, std::abs(d.estimator_gain(i))));
+    }
+    expect_same_roots(d.regulator_poles, roots_of(c.at("lqr_poles")), 1e-7, "regulator");
+    expect_same_roots(d.estimator_poles, roots_of(c.at("kf_poles")), 1e-7, "estimator");
+  }
+}
+
+TEST(Lqg, BadWeightsAreInputErrors) {
+  VelocityLqgOptions o;
+  o.kbw = 0.0;
+  test::expect_input_error([&] { (void)velocity_lqg(normalized(3.0, 0.01), 3.0, o); }, "kbw", "");
+  o = {};
+  o.measurement_noise = -1.0;
+  test::expect_input_error([&] { (void)velocity_lqg(normalized(3.0, 0.01), 3.0, o); }, "measurement_noise", "");
+  test::expect_input_error([&] { (void)velocity_lqg(normalized(3.0, 0.01), 0.9); }, "r", "");
+  PositionLqgOptions po;
+  po.q(2) = -1.0;
+  test::expect_input_error([&] { (void)position_lqg(normalized(3.0, 0.01), 3.0, po); }, "q", "");
+}
+
+}  // namespace lqg_test
+}  // namespace
+}  // namespace servotwin::tuning
