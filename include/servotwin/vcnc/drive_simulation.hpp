@@ -14,7 +14,7 @@
 /// at the plant's ts (prewarped at the controller's prewarp frequency when it lies below Nyquist).
 ///
 /// Feedback signals: a motor_velocity plant output is the velocity feedback (the position of a
-/// pi+p loop is its running sum ts·Σω); a motor_position output (an encoder) is the position
+/// pi+p loop is its trapezoidal integral); a motor_position output (an encoder) is the position
 /// feedback and its backward difference the velocity, so encoder quantization reaches the loop as
 /// a drive sees it. Load-side outputs are refused: the cascade feeds back the motor.
 ///
