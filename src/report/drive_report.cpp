@@ -25,13 +25,6 @@ bool position_loop(const vcnc::DriveSimulation& s) { return s.structure == tunin
 std::string controlled_name(const vcnc::DriveSimulation& s) {
   return std::string(s.load_side ? "load " : "motor ") + (position_loop(s) ? "position" : "velocity");
 }
-Signal controlled_signal(const vcnc::DriveSimulation& s) {
-  const bool load = s.load_side, position = position_loop(s);
-  return [load, position](const vcnc::DriveSample& x) {
-    if (position) return load ? x.load_position : x.motor_position;
-    return load ? x.load_velocity : x.motor_velocity;
-  };
-}
 std::string unit_of(const vcnc::DriveSimulation& s) { return position_loop(s) ? "rad" : "rad/s"; }
 
 std::vector<double> column(const std::vector<vcnc::DriveSample>& samples, const Signal& f) {
@@ -63,7 +56,7 @@ std::vector<Chart> charts(const vcnc::DriveSimulation& s) {
   std::vector<Chart> out;
   const std::string what = controlled_name(s);
   Chart controlled = pair_chart(s, fmt::format("{} ({})", what, vcnc::to_string(s.test)),
-                                fmt::format("{} [{}]", what, unit_of(s)), controlled_signal(s));
+                                fmt::format("{} [{}]", what, unit_of(s)), vcnc::controlled_variable(s));
   if (s.test == vcnc::DriveTest::kSetpointStep)
     controlled.series.push_back({"reference", t, column(s.samples, [](const vcnc::DriveSample& x) { return x.reference; })});
   out.push_back(std::move(controlled));

@@ -159,15 +159,7 @@ LoopRun run_loop(const machine::PlantConfig& config, const core::DiscreteStateSp
   return run;
 }
 
-/// The controlled variable of a sample: load (or motor) velocity, or position for pi+p.
-struct Selector {
-  bool position = false;
-  bool load = false;
-  [[nodiscard]] double operator()(const DriveSample& s) const noexcept {
-    if (position) return load ? s.load_position : s.motor_position;
-    return load ? s.load_velocity : s.motor_velocity;
-  }
-};
+using Selector = ControlledVariable;
 
 /// Time at which the series first reaches `level` (linear interpolation), +inf if never.
 double first_crossing(const std::vector<DriveSample>& samples, Selector select, double level) {
@@ -304,6 +296,10 @@ std::optional<DriveTest> drive_test_from_string(std::string_view text) noexcept 
   return std::nullopt;
 }
 
+ControlledVariable controlled_variable(const DriveSimulation& simulation) noexcept {
+  return {simulation.structure == tuning::Structure::kPiP, simulation.load_side};
+}
+
 machine::PlantConfig linear_part(const machine::PlantConfig& plant) {
   machine::PlantConfig linear = plant;
   if (auto* chain = std::get_if<machine::MassChain>(&linear.model)) {
@@ -336,7 +332,7 @@ DriveSimulation simulate_drive(const machine::PlantConfig& plant, const tuning::
 
   const std::optional<double> kpp = is_position_loop(controller) ? controller.kpp_physical : std::nullopt;
   out.kpp = kpp;
-  const Selector select{is_position_loop(controller), out.load_side};
+  const Selector select = controlled_variable(out);
   const machine::PlantConfig linear_plant = linear_part(plant);
   const auto run_linear = [&](std::size_t steps) {
     return run_loop(linear_plant, out.controller, kpp, settings.test, settings.amplitude, steps, std::nullopt);

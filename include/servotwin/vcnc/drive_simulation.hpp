@@ -73,6 +73,17 @@ struct DriveSample {
   double measured = 0.0;        ///< the plant's measured output y at t (noise, quantization)
 };
 
+/// The variable a run's metrics judge: the load velocity (pi, pid) or load position (pi+p) when
+/// the plant has a load, else the motor's.
+struct ControlledVariable {
+  bool position = false;  ///< position (pi+p) rather than velocity
+  bool load = false;      ///< the load rather than the motor
+  [[nodiscard]] double operator()(const DriveSample& s) const noexcept {
+    if (position) return load ? s.load_position : s.motor_position;
+    return load ? s.load_velocity : s.motor_velocity;
+  }
+};
+
 /// Step-response and disturbance numbers of one run. The controlled variable is the load velocity
 /// (pi, pid) or load position (pi+p) when the plant has a load, else the motor's.
 struct DriveMetrics {
@@ -114,6 +125,9 @@ struct DriveSimulation {
   core::DiscreteStateSpace controller;  ///< the discrete velocity controller used
   std::vector<std::string> notes;       ///< what a user must know (mismatched scales, limits hit, ...)
 };
+
+/// The controlled variable of `simulation` (its structure and whether the plant has a load).
+[[nodiscard]] ControlledVariable controlled_variable(const DriveSimulation& simulation) noexcept;
 
 /// The plant's linear part: friction, backlash, noise and quantization removed (inertias,
 /// stiffnesses, shaft damping, viscous friction, current lag and delay kept).
