@@ -119,7 +119,7 @@ BENCHMARK(BM_LargestRobustOmegaStar)->Arg(30)->Arg(48)->Unit(benchmark::kMillise
 // normalization, advice, admissible range, the automatic ω* scan (24 candidates + refinement, each
 // a placement, a Routh test, two peaks and a bandwidth with the HF dynamics), the final analysis
 // (indices, margins, time responses). Arg 0: PI; 1: PI with an uncertainty weight (RP in the scan);
-// 2: PID; 3: PI + P position loop.
+// 2: PID; 3: PI + P position loop; 4: LQG (kbw and kff searches, C7.13); 5: LQG with W2.
 void BM_TuneAutomatic(benchmark::State& state) {
   const fit::PlantModel model = belt_axis();
   TuneOptions o;
@@ -136,13 +136,20 @@ void BM_TuneAutomatic(benchmark::State& state) {
     case 3:
       o.structure = Structure::kPiP;
       break;
+    case 4:  // lqg: the kbw search (36 designs + bisection) and the feedforward search
+      o.structure = Structure::kLqg;
+      break;
+    case 5:  // lqg with W2: robust tracking in every candidate
+      o.structure = Structure::kLqg;
+      o.w2 = core::TransferFunction(core::Polynomial{0.5 / wz, 0.05}, core::Polynomial{1.0 / wz, 1.0});
+      break;
     default:
       break;
   }
   for (auto _ : state) benchmark::DoNotOptimize(tune(model, o));
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_TuneAutomatic)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TuneAutomatic)->DenseRange(0, 5)->Unit(benchmark::kMillisecond);
 
 /// One LQG design (two 4x4 or 5x5 Riccati solves, the compensator and every pole set): the inner
 /// step of a kbw search, so it should stay well under a millisecond.

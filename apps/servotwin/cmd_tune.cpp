@@ -30,6 +30,8 @@ struct TuneArgs {
   std::string structure = "pi";
   double zeta_star = 0.8;
   std::string omega_star = "auto";
+  std::string kbw = "auto", kff = "auto";
+  bool raw_motor_velocity = false;
   double target_r = 2.0;
   std::optional<double> tau;
   bool allow_negative_kd = false;
@@ -42,11 +44,12 @@ struct TuneArgs {
   std::string report;
 };
 
-std::optional<double> parse_omega_star(const std::string& text) {
+/// "auto" (std::nullopt) or a number >= 0 (> 0 unless `zero_ok`).
+std::optional<double> parse_auto(const std::string& text, const char* flag, bool zero_ok, const char* what) {
   if (text == "auto") return std::nullopt;
   const std::optional<double> v = parse_number(text);
-  if (!v || *v <= 0.0) {
-    throw core::InputError(core::at_field("--omega-star"), "expected \"auto\" or omega*/omega_z > 0, got \"" + text + "\"");
+  if (!v || *v < 0.0 || (!zero_ok && *v == 0.0)) {
+    throw core::InputError(core::at_field(flag), fmt::format("expected \"auto\" or {}, got \"{}\"", what, text));
   }
   return v;
 }
@@ -74,7 +77,10 @@ tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
   tuning::TuneOptions o;
   o.structure = *tuning::structure_from_string(a.structure);
   o.zeta_star = a.zeta_star;
-  o.omega_star = parse_omega_star(a.omega_star);
+  o.omega_star = parse_auto(a.omega_star, "--omega-star", false, "omega*/omega_z > 0");
+  o.kbw = parse_auto(a.kbw, "--kbw", false, "a bandwidth knob > 0");
+  o.feedforward = parse_auto(a.kff, "--kff", true, "a normalized feedforward gain >= 0");
+  o.lqg.raw_motor_velocity = a.raw_motor_velocity;
   o.target_r = a.target_r;
   o.tau = a.tau;
   o.allow_negative_kd = a.allow_negative_kd;
@@ -107,14 +113,10 @@ std::string margin(double v, const char* unit) {
   return fmt::format("{:.3g} {}", v, unit);
 }
 
-void print_summary(const tuning::TuneResult& r, const std::string& source) {
+/// The pole-placement part of the summary: advice, admissible range, ω* and the gains.
+void print_cascade(const tuning::TuneResult& r, double hz) {
   const tuning::NormalizedPlant& p = r.plant;
   const tuning::Controller& c = r.controller;
-  const double hz = p.omega_z / kTwoPi;
-  fmt::print("{}: antiresonance {:.4g} Hz, resonance ratio r = {:.4g}, zeta_z = {:.3g}, zeta_p = {:.3g}, "
-             "rigid pole a = {:.3g} omega_z, Im = {:.5g}{}\n",
-             source, hz, p.r, p.zeta_z, p.zeta_p, p.a, p.motor_inertia,
-             p.higher_modes.empty() ? "" : fmt::format(", {} higher mode(s)", p.higher_modes.size()));
   fmt::print("advice: {}\n", r.advice.verdict);
   fmt::print("admissible omega*: [{:.4g}, {:.4g}] omega_z = [{:.4g}, {:.4g}] Hz (upper end: {})\n", r.range.omega_min,
              r.range.omega_max, r.range.omega_min * hz, r.range.omega_max * hz, tuning::to_string(r.range.upper));
@@ -131,6 +133,30 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
                c.position->kpp_rs ? fmt::format(", robust-stability limit {:.6g}", *c.position->kpp_rs * p.omega_z) : "",
                c.position->bandwidth_load * hz, c.position->j2);
   }
+}
+
+/// The LQG part of the summary: kbw, kff and the compensator's stability.
+void print_lqg(const tuning::FullOrderSummary& f, const tuning::PlantScales& scales) {
+  fmt::print("structure lqg (C7.13, {} states): kbw = {:.4g} ({}), feedforward kff = {:.4g} normalized = {:.4g} "
+             "torque per velocity ({})\n",
+             f.compensator.states(), f.weights.kbw, f.kbw_source, f.weights.feedforward,
+             f.weights.feedforward * scales.motor_inertia * scales.omega_z, f.feedforward_source);
+  fmt::print("compensator: {}\n", f.controller_stable ? "stable" : "UNSTABLE (stable only inside the closed loop)");
+}
+
+void print_summary(const tuning::TuneResult& r, const std::string& source) {
+  const tuning::NormalizedPlant& p = r.plant;
+  const tuning::Controller& c = r.controller;
+  const double hz = p.omega_z / kTwoPi;
+  fmt::print("{}: antiresonance {:.4g} Hz, resonance ratio r = {:.4g}, zeta_z = {:.3g}, zeta_p = {:.3g}, "
+             "rigid pole a = {:.3g} omega_z, Im = {:.5g}{}\n",
+             source, hz, p.r, p.zeta_z, p.zeta_p, p.a, p.motor_inertia,
+             p.higher_modes.empty() ? "" : fmt::format(", {} higher mode(s)", p.higher_modes.size()));
+  if (c.full_order) {
+    print_lqg(*c.full_order, c.plant);
+  } else {
+    print_cascade(r, hz);
+  }
   const tuning::LoopIndices& i = c.predicted;
   fmt::print("predicted (with the known HF dynamics): {}\n", i.closed_loop_stable ? "stable" : "UNSTABLE");
   fmt::print("  bandwidth: motor {:.4g} Hz, load {}\n", i.bandwidth_motor * hz,
@@ -145,6 +171,10 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
     fmt::print("  robustness: ||W2 T|| = {:.4f} (RS {}), ||S||/Ms = {:.4f}, RP {:.4f} ({})\n", *c.robustness.rs,
                *c.robustness.rs < 1.0 ? "ok" : "FAILS", *c.robustness.np, *c.robustness.rp,
                *c.robustness.rp < 1.0 ? "ok" : "fails");
+  }
+  if (c.robustness.rp_tracking) {
+    fmt::print("  robust tracking (C7.13, worst-case ||wm/w*||/Mt): {:.4f} ({})\n", *c.robustness.rp_tracking,
+               *c.robustness.rp_tracking < 1.0 ? "ok" : "fails");
   }
   if (c.discrete) {
     fmt::print("discretized at ts = {:.4g} s (Tustin{})\n", c.discrete->ts,
@@ -221,19 +251,33 @@ int run(const TuneArgs& a, const GlobalOptions& global) {
 void register_tune(CLI::App& app, Action& selected) {
   auto a = std::make_shared<TuneArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "tune", "Tune a cascade PI/PID velocity loop (and P position loop) for a flexible drive from its plant model");
+      "tune",
+      "Tune a cascade PI/PID velocity loop (and P position loop) or a full-order LQG for a flexible drive from its "
+      "plant model");
   cmd->add_option("plant", a->plant,
                   "Plant: a fitted model (servotwin.plant-model/1 from `servotwin fit`), a plant description "
                   "(servotwin.plant/1) or a flexible preset name")
       ->required();
-  cmd->add_option("--structure", a->structure, "pi, pid (virtual inertia, C7.5) or pi+p (P position loop over the PI)")
-      ->check(CLI::IsMember({"pi", "pid", "pi+p"}))
+  cmd->add_option("--structure", a->structure,
+                  "pi, pid (virtual inertia, C7.5), pi+p (P position loop over the PI) or lqg (full-order velocity "
+                  "LQG, C7.13)")
+      ->check(CLI::IsMember({"pi", "pid", "pi+p", "lqg"}))
       ->capture_default_str();
   cmd->add_option("--zeta-star", a->zeta_star, "Damping of the assigned closed-loop pole pair")->capture_default_str();
   cmd->add_option("--omega-star", a->omega_star,
                   "Natural frequency of the assigned pair relative to the antiresonance (omega*/omega_z), or auto: "
                   "the largest load bandwidth within --ms/--mt")
       ->capture_default_str();
+  cmd->add_option("--kbw", a->kbw,
+                  "LQG: bandwidth knob of the normalized weights (larger = slower), or auto: the fastest within "
+                  "--ms/--mt (and robust tracking with W2)")
+      ->capture_default_str();
+  cmd->add_option("--kff", a->kff,
+                  "LQG: velocity-reference feedforward to the torque (normalized), or auto: the largest keeping the "
+                  "tracking peak within --mt")
+      ->capture_default_str();
+  cmd->add_flag("--raw-motor-velocity", a->raw_motor_velocity,
+                "LQG: feed back the measured motor velocity instead of its estimate (C7.13 variant)");
   cmd->add_option("--target-r", a->target_r, "PID: virtual resonance ratio r-bar the derivative gain creates")
       ->capture_default_str();
   cmd->add_option("--tau", a->tau, "PID: derivative filter time constant [s] (default: 1/max(r, 5 omega*) in omega_z units)");
@@ -261,6 +305,7 @@ void register_tune(CLI::App& app, Action& selected) {
                "  servotwin tune plant_model.json --structure pid --target-r 2 --ts 0.000125 -o pid.json\n"
                "  servotwin tune table-5.1 --structure pi+p --omega-star 0.4 --zeta-star 1 --report tune.html\n"
                "  servotwin tune plant_model.json --w2-from-frf frf.csv\n"
+               "  servotwin tune table-5.1 --structure lqg --ts 0.000125 -o lqg.json --report lqg.html\n"
                "  servotwin tune plant_model.json --delay 0.0005 --w2-num 2.6,0 --w2-den 1,15 --ms 1.6\n");
   cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });
 }

@@ -123,6 +123,15 @@ std::pair<std::string, double> physical_twin(const IndexField& f, double omega_z
   return {std::string(f.name) + "_s", 1.0 / omega_z};
 }
 
+json poles_json(const std::vector<std::complex<double>>& poles, const std::string& section) {
+  json out = json::array();
+  for (std::size_t i = 0; i < poles.size(); ++i) {
+    const std::string field = section + "[" + std::to_string(i) + "]";
+    out.push_back({finite(poles[i].real(), field), finite(poles[i].imag(), field)});
+  }
+  return out;
+}
+
 json predicted_json(const LoopIndices& p, double omega_z) {
   json j = {{"closed_loop_stable", p.closed_loop_stable}};
   for (const IndexField& f : kIndexFields) {
@@ -132,12 +141,7 @@ json predicted_json(const LoopIndices& p, double omega_z) {
     const auto [twin, factor] = physical_twin(f, omega_z);
     j[twin] = extended(v * factor);
   }
-  json poles = json::array();
-  for (std::size_t i = 0; i < p.closed_loop_poles.size(); ++i) {
-    const std::string field = "predicted.closed_loop_poles[" + std::to_string(i) + "]";
-    poles.push_back({finite(p.closed_loop_poles[i].real(), field), finite(p.closed_loop_poles[i].imag(), field)});
-  }
-  j["closed_loop_poles"] = poles;
+  j["closed_loop_poles"] = poles_json(p.closed_loop_poles, "predicted.closed_loop_poles");
   return j;
 }
 
@@ -147,7 +151,10 @@ json robustness_json(const tuning::RobustnessSummary& r) {
     if (std::isnan(*v)) throw std::invalid_argument(std::string("controller_to_json: robustness.") + name + " is NaN");
     return extended(*v);
   };
-  return {{"rs", put(r.rs, "rs")}, {"np", put(r.np, "np")}, {"rp", put(r.rp, "rp")}};
+  return {{"rs", put(r.rs, "rs")},
+          {"np", put(r.np, "np")},
+          {"rp", put(r.rp, "rp")},
+          {"rp_tracking", put(r.rp_tracking, "rp_tracking")}};
 }
 
 json position_json(const std::optional<tuning::PositionSummary>& p, double omega_z) {
@@ -159,6 +166,33 @@ json position_json(const std::optional<tuning::PositionSummary>& p, double omega
           {"bandwidth_load_hz", p->bandwidth_load * omega_z / kTwoPi},
           {"j2", finite(p->j2, "position.j2")},
           {"peak_load_tracking", finite(p->peak_load_tracking, "position.peak_load_tracking")}};
+}
+
+json state_space_json(const core::StateSpace& ss, const std::string& section) {
+  return {{"inputs", kInputNames},
+          {"output", "torque"},
+          {"A", matrix_json(ss.A, section + ".A")},
+          {"B", matrix_json(ss.B, section + ".B")},
+          {"C", matrix_json(ss.C, section + ".C")},
+          {"D", matrix_json(ss.D, section + ".D")}};
+}
+
+json lqg_json(const std::optional<tuning::FullOrderSummary>& f) {
+  if (!f) return nullptr;
+  const tuning::VelocityLqgOptions& w = f->weights;
+  return {{"kbw", finite(w.kbw, "lqg.kbw")},
+          {"kbw_source", f->kbw_source},
+          {"feedforward", finite(w.feedforward, "lqg.feedforward")},
+          {"feedforward_source", f->feedforward_source},
+          {"q_load_velocity", finite(w.q_load_velocity, "lqg.q_load_velocity")},
+          {"q_integral", finite(w.q_integral, "lqg.q_integral")},
+          {"noise_motor", finite(w.noise_motor, "lqg.noise_motor")},
+          {"noise_load_torque", finite(w.noise_load_torque, "lqg.noise_load_torque")},
+          {"measurement_noise", finite(w.measurement_noise, "lqg.measurement_noise")},
+          {"raw_motor_velocity", w.raw_motor_velocity},
+          {"controller_stable", f->controller_stable},
+          {"controller_poles", poles_json(f->controller_poles, "lqg.controller_poles")},
+          {"compensator", state_space_json(f->compensator, "lqg.compensator")}};
 }
 
 // ---------------------------------------------------------------- reader
@@ -367,12 +401,19 @@ void check_derived(const Section& s, const char* derived, const char* base, doub
                         json(extended(expected)).dump() + " (agreement within 1e-6 relative expected)");
 }
 
-tuning::DesignParameters read_design(const Section& s, double omega_z) {
+tuning::DesignParameters read_design(const Section& s, double omega_z, Structure structure) {
   s.object.allow_only({"omega_star", "omega_star_hz", "zeta_star", "r_target", "ms", "mt", "omega_star_source"});
   tuning::DesignParameters d;
-  d.omega_star = s.positive("omega_star", "a normalized bandwidth ω*/ωz");
-  check_derived(s, "omega_star_hz", "omega_star", d.omega_star, omega_z / kTwoPi, "× ωz/2π");
-  d.zeta_star = s.positive("zeta_star", "a damping ratio");
+  if (tuning::is_full_order(structure)) {
+    // A full-order design assigns no pole pair: ω* and ζ* are null.
+    for (const char* key : {"omega_star", "omega_star_hz", "zeta_star"}) {
+      if (!s.raw(key).is_null()) s.fail(key, "expected null for a full-order controller (no assigned pole pair)");
+    }
+  } else {
+    d.omega_star = s.positive("omega_star", "a normalized bandwidth ω*/ωz");
+    check_derived(s, "omega_star_hz", "omega_star", d.omega_star, omega_z / kTwoPi, "× ωz/2π");
+    d.zeta_star = s.positive("zeta_star", "a damping ratio");
+  }
   d.r_target = s.nullable("r_target");
   if (d.r_target && !(*d.r_target > 1.0))
     s.fail("r_target", "expected a target resonance ratio > 1 or null, got " + show(*d.r_target));
@@ -383,6 +424,21 @@ tuning::DesignParameters read_design(const Section& s, double omega_z) {
   }
   d.omega_star_source = s.object.string("omega_star_source");
   return d;
+}
+
+std::vector<std::complex<double>> read_poles(const Section& s, std::string_view key) {
+  const json& poles = s.raw(key);
+  const std::string name(key);
+  if (!poles.is_array()) s.fail(key, "expected an array of [re, im] pairs");
+  std::vector<std::complex<double>> out;
+  for (std::size_t i = 0; i < poles.size(); ++i) {
+    const json& e = poles[i];
+    const bool pair = e.is_array() && e.size() == 2 && e[0].is_number() && e[1].is_number() &&
+                      std::isfinite(e[0].get<double>()) && std::isfinite(e[1].get<double>());
+    if (!pair) s.fail(name + "[" + std::to_string(i) + "]", "expected a pair [re, im] of finite numbers, found " + e.dump());
+    out.emplace_back(e[0].get<double>(), e[1].get<double>());
+  }
+  return out;
 }
 
 LoopIndices read_predicted(const Section& s, double omega_z) {
@@ -406,17 +462,7 @@ LoopIndices read_predicted(const Section& s, double omega_z) {
     check_derived(s, twin.c_str(), f.name, p.*f.member, factor, f.scale == Scale::kFrequency ? "× ωz/2π" : "/ ωz");
   }
 
-  const json& poles = s.raw("closed_loop_poles");
-  if (!poles.is_array()) s.fail("closed_loop_poles", "expected an array of [re, im] pairs");
-  for (std::size_t i = 0; i < poles.size(); ++i) {
-    const json& e = poles[i];
-    const bool pair = e.is_array() && e.size() == 2 && e[0].is_number() && e[1].is_number() &&
-                      std::isfinite(e[0].get<double>()) && std::isfinite(e[1].get<double>());
-    if (!pair)
-      s.fail("closed_loop_poles[" + std::to_string(i) + "]",
-             "expected a pair [re, im] of finite numbers, found " + e.dump());
-    p.closed_loop_poles.emplace_back(e[0].get<double>(), e[1].get<double>());
-  }
+  p.closed_loop_poles = read_poles(s, "closed_loop_poles");
   return p;
 }
 
@@ -445,7 +491,7 @@ std::optional<tuning::PositionSummary> read_position(const Section& root, Struct
 }
 
 tuning::RobustnessSummary read_robustness(const Section& s) {
-  s.object.allow_only({"rs", "np", "rp"});
+  s.object.allow_only({"rs", "np", "rp", "rp_tracking"});
   const auto read = [&](const char* key) -> std::optional<double> {
     if (s.raw(key).is_null()) return std::nullopt;
     const double v = s.extended(key);
@@ -456,6 +502,7 @@ tuning::RobustnessSummary read_robustness(const Section& s) {
   r.rs = read("rs");
   r.np = read("np");
   r.rp = read("rp");
+  if (s.value.contains("rp_tracking")) r.rp_tracking = read("rp_tracking");  // absent in files of 2026-11-23 and before
   return r;
 }
 
@@ -468,21 +515,26 @@ std::vector<double> continuous_check_frequencies(double omega_z, const tuning::P
   return w;
 }
 
-void read_state_space(const Section& root, const tuning::PidGains& physical, double omega_z) {
-  const Section s = root.section("state_space");
+/// The members "inputs", "output", "A".."D" of a controller state space.
+core::StateSpace read_controller_matrices(const Section& s) {
   s.object.allow_only({"inputs", "output", "A", "B", "C", "D"});
   const json& inputs = s.raw("inputs");
   if (inputs != json(kInputNames))
     s.fail("inputs", "expected [\"velocity_reference\", \"motor_velocity\"], got " + inputs.dump());
   s.expect_string("output", "torque");
-  core::StateSpace file;
-  read_matrices(s, file.A, file.B, file.C, file.D);
-  const core::StateSpace expected = tuning::controller_state_space(physical);
-  const auto response = [](const core::StateSpace& sys, double w) { return core::frequency_response(sys, w); };
-  check_realization(root, "state_space", file, expected, continuous_check_frequencies(omega_z, physical), response);
+  core::StateSpace out;
+  read_matrices(s, out.A, out.B, out.C, out.D);
+  return out;
 }
 
-std::optional<core::DiscreteStateSpace> read_discrete(const Section& root, const tuning::PidGains& physical,
+/// The physical state space must realize `expected` (the gains', or the compensator de-normalized).
+void read_state_space(const Section& root, const core::StateSpace& expected, const std::vector<double>& omegas) {
+  const core::StateSpace file = read_controller_matrices(root.section("state_space"));
+  const auto response = [](const core::StateSpace& sys, double w) { return core::frequency_response(sys, w); };
+  check_realization(root, "state_space", file, expected, omegas, response);
+}
+
+std::optional<core::DiscreteStateSpace> read_discrete(const Section& root, const tuning::Controller& c,
                                                       std::optional<double>& prewarp_rad_s) {
   if (root.raw("discrete").is_null()) return std::nullopt;
   const Section s = root.section("discrete");
@@ -499,13 +551,69 @@ std::optional<core::DiscreteStateSpace> read_discrete(const Section& root, const
   core::DiscreteStateSpace file;
   file.ts = ts;
   read_matrices(s, file.A, file.B, file.C, file.D);
-  const core::DiscreteStateSpace expected = tuning::discretize_controller(physical, ts, prewarp_rad_s);
+  const core::DiscreteStateSpace expected = tuning::discretize_controller(c, ts, prewarp_rad_s);
   std::vector<double> omegas;
   for (double k : {1e-3, 1e-2, 0.1, 0.3, 0.6, 0.9}) omegas.push_back(k * kTwoPi * nyquist_hz);
   if (prewarp_rad_s) omegas.push_back(*prewarp_rad_s);
   const auto response = [](const core::DiscreteStateSpace& sys, double w) { return core::frequency_response(sys, w); };
   check_realization(root, "discrete", file, expected, omegas, response);
   return file;
+}
+
+/// Every listed pole must be an eigenvalue of `a` (one to one, relative 1e-6 of the largest).
+void check_poles(const Section& s, std::string_view key, const std::vector<std::complex<double>>& listed,
+                 const Eigen::MatrixXd& a) {
+  const Eigen::VectorXcd eig = a.eigenvalues();
+  std::vector<std::complex<double>> left(eig.data(), eig.data() + eig.size());
+  if (listed.size() != left.size())
+    s.fail(key, "expected the " + std::to_string(left.size()) + " eigenvalues of compensator.A, got " +
+                    std::to_string(listed.size()) + " poles");
+  double scale = 1.0;
+  for (const auto& p : left) scale = std::max(scale, std::abs(p));
+  for (std::size_t i = 0; i < listed.size(); ++i) {
+    const auto nearest = std::min_element(left.begin(), left.end(), [&](auto x, auto y) {
+      return std::abs(x - listed[i]) < std::abs(y - listed[i]);
+    });
+    if (!(std::abs(*nearest - listed[i]) <= kRelTol * scale))
+      s.fail(std::string(key) + "[" + std::to_string(i) + "]",
+             fmt::format("{}{:+.9g}j is not an eigenvalue of compensator.A (nearest {}{:+.9g}j)", show(listed[i].real()),
+                         listed[i].imag(), show(nearest->real()), nearest->imag()));
+    left.erase(nearest);
+  }
+}
+
+/// The "lqg" section: null for the cascade structures, the compensator and its weights for lqg.
+std::optional<tuning::FullOrderSummary> read_lqg(const Section& root, Structure structure) {
+  const bool present = root.value.contains("lqg") && !root.raw("lqg").is_null();  // absent before lqg existed
+  const bool wanted = tuning::is_full_order(structure);
+  if (present != wanted)
+    root.fail("lqg", wanted ? "an \"lqg\" controller needs its compensator section"
+                            : "only an \"lqg\" controller has a compensator section (expected null)");
+  if (!present) return std::nullopt;
+  const Section s = root.section("lqg");
+  s.object.allow_only({"kbw", "kbw_source", "feedforward", "feedforward_source", "q_load_velocity", "q_integral",
+                       "noise_motor", "noise_load_torque", "measurement_noise", "raw_motor_velocity",
+                       "controller_stable", "controller_poles", "compensator"});
+  tuning::FullOrderSummary f;
+  tuning::VelocityLqgOptions& w = f.weights;
+  w.kbw = s.positive("kbw", "a bandwidth knob");
+  f.kbw_source = s.object.string("kbw_source");
+  w.feedforward = s.non_negative("feedforward", "a feedforward gain");
+  f.feedforward_source = s.object.string("feedforward_source");
+  w.q_load_velocity = s.non_negative("q_load_velocity", "a state weight");
+  w.q_integral = s.non_negative("q_integral", "a state weight");
+  w.noise_motor = s.non_negative("noise_motor", "a noise intensity");
+  w.noise_load_torque = s.non_negative("noise_load_torque", "a noise intensity");
+  w.measurement_noise = s.positive("measurement_noise", "a noise intensity");
+  w.raw_motor_velocity = s.boolean("raw_motor_velocity");
+  f.compensator = read_controller_matrices(s.section("compensator"));
+  f.controller_poles = read_poles(s, "controller_poles");
+  check_poles(s, "controller_poles", f.controller_poles, f.compensator.A);
+  f.controller_stable = s.boolean("controller_stable");
+  if (f.controller_stable != tuning::stable_except_integrator(f.controller_poles))
+    s.fail("controller_stable", std::string("contradicts controller_poles (they say ") +
+                                    (f.controller_stable ? "unstable" : "stable") + ")");
+  return f;
 }
 
 std::vector<std::string> read_notes(const Section& root) {
@@ -528,9 +636,12 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
     throw std::invalid_argument("controller_to_json: a position gain kpp belongs to exactly the \"pi+p\" controllers");
   if (position != c.position.has_value())
     throw std::invalid_argument("controller_to_json: the position-loop summary belongs to exactly the \"pi+p\" controllers");
+  const bool full_order = tuning::is_full_order(c.structure);
+  if (full_order != c.full_order.has_value())
+    throw std::invalid_argument("controller_to_json: the compensator section belongs to exactly the \"lqg\" controllers");
   const double wz = finite(c.plant.omega_z, "plant.omega_z");
   const tuning::PlantScales& p = c.plant;
-  const core::StateSpace ss = tuning::controller_state_space(c.physical);
+  const core::StateSpace ss = tuning::controller_state_space(c);
   json discrete = nullptr;
   if (c.discrete) {
     const core::DiscreteStateSpace& d = *c.discrete;
@@ -556,20 +667,14 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
             {"zeta_z", finite(p.zeta_z, "plant.zeta_z")},
             {"zeta_p", finite(p.zeta_p, "plant.zeta_p")},
             {"a", finite(p.a, "plant.a")}}},
-          {"gains", gains_json(c.physical, c.kpp_physical, "gains")},
-          {"normalized", gains_json(c.normalized, c.kpp_normalized, "normalized")},
-          {"state_space",
-           {{"inputs", kInputNames},
-            {"output", "torque"},
-            {"A", matrix_json(ss.A, "state_space.A")},
-            {"B", matrix_json(ss.B, "state_space.B")},
-            {"C", matrix_json(ss.C, "state_space.C")},
-            {"D", matrix_json(ss.D, "state_space.D")}}},
+          {"gains", full_order ? json(nullptr) : gains_json(c.physical, c.kpp_physical, "gains")},
+          {"normalized", full_order ? json(nullptr) : gains_json(c.normalized, c.kpp_normalized, "normalized")},
+          {"state_space", state_space_json(ss, "state_space")},
           {"discrete", discrete},
           {"design",
-           {{"omega_star", finite(d.omega_star, "design.omega_star")},
-            {"omega_star_hz", d.omega_star * wz / kTwoPi},
-            {"zeta_star", finite(d.zeta_star, "design.zeta_star")},
+           {{"omega_star", full_order ? json(nullptr) : json(finite(d.omega_star, "design.omega_star"))},
+            {"omega_star_hz", full_order ? json(nullptr) : json(d.omega_star * wz / kTwoPi)},
+            {"zeta_star", full_order ? json(nullptr) : json(finite(d.zeta_star, "design.zeta_star"))},
             {"r_target", optional_finite(d.r_target, "design.r_target")},
             {"ms", optional_finite(d.ms, "design.ms")},
             {"mt", optional_finite(d.mt, "design.mt")},
@@ -577,6 +682,7 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
           {"predicted", predicted_json(c.predicted, wz)},
           {"robustness", robustness_json(c.robustness)},
           {"position", position_json(c.position, wz)},
+          {"lqg", lqg_json(c.full_order)},
           {"notes", c.notes}};
 }
 
@@ -585,13 +691,13 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
   check_format(document, kControllerFormat, source_name);
   const Section root(document, "", source_name);
   root.object.allow_only({"format", "structure", "loop", "feedback", "plant", "gains", "normalized", "state_space",
-                          "discrete", "design", "predicted", "robustness", "position", "notes"});
+                          "discrete", "design", "predicted", "robustness", "position", "lqg", "notes"});
   LoadedController out;
   tuning::Controller& c = out.controller;
 
   const std::string structure = root.object.string("structure");
   const auto parsed = tuning::structure_from_string(structure);
-  if (!parsed) root.fail("structure", "expected \"pi\", \"pid\" or \"pi+p\", got \"" + structure + "\"");
+  if (!parsed) root.fail("structure", "expected \"pi\", \"pid\", \"pi+p\" or \"lqg\", got \"" + structure + "\"");
   c.structure = *parsed;
   const std::string loop = root.object.string("loop");
   if (loop != "velocity" && loop != "position")
@@ -602,18 +708,28 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
   root.expect_string("feedback", "motor");
 
   c.plant = read_plant(root.section("plant"), out.plant_source);
-  const Section gains = root.section("gains");
-  const GainsRead physical = read_gains(gains, c.structure);
-  const GainsRead normalized = read_gains(root.section("normalized"), c.structure);
-  check_gains_agree(gains, physical, normalized, c.plant);
-  c.physical = physical.gains;
-  c.normalized = normalized.gains;
-  c.kpp_physical = physical.kpp;
-  c.kpp_normalized = normalized.kpp;
-
-  read_state_space(root, c.physical, c.plant.omega_z);
-  c.discrete = read_discrete(root, c.physical, c.prewarp_rad_s);
-  c.design = read_design(root.section("design"), c.plant.omega_z);
+  std::vector<double> check_omegas = continuous_check_frequencies(c.plant.omega_z, c.physical);
+  if (tuning::is_full_order(c.structure)) {
+    for (const char* key : {"gains", "normalized"}) {
+      if (!root.raw(key).is_null()) root.fail(key, "expected null for an \"lqg\" controller (its law is the compensator)");
+    }
+    c.full_order = read_lqg(root, c.structure);
+    read_state_space(root, tuning::controller_state_space(c), check_omegas);
+  } else {
+    (void)read_lqg(root, c.structure);
+    const Section gains = root.section("gains");
+    const GainsRead physical = read_gains(gains, c.structure);
+    const GainsRead normalized = read_gains(root.section("normalized"), c.structure);
+    check_gains_agree(gains, physical, normalized, c.plant);
+    c.physical = physical.gains;
+    c.normalized = normalized.gains;
+    c.kpp_physical = physical.kpp;
+    c.kpp_normalized = normalized.kpp;
+    check_omegas = continuous_check_frequencies(c.plant.omega_z, c.physical);
+    read_state_space(root, tuning::controller_state_space(c.physical), check_omegas);
+  }
+  c.discrete = read_discrete(root, c, c.prewarp_rad_s);
+  c.design = read_design(root.section("design"), c.plant.omega_z, c.structure);
   c.predicted = read_predicted(root.section("predicted"), c.plant.omega_z);
   c.robustness = read_robustness(root.section("robustness"));
   c.position = read_position(root, c.structure, c.plant.omega_z);

@@ -109,13 +109,21 @@ Table gains_table(const vcnc::DriveSimulation& s) {
   t.title = "Controller and run";
   t.header = {"quantity", "value"};
   t.rows.push_back({"structure", tuning::to_string(s.structure)});
-  t.rows.push_back({"Kp", num(s.gains.kp, 6)});
-  t.rows.push_back({"Ki", num(s.gains.ki, 6)});
-  if (s.gains.kd != 0.0) {
-    t.rows.push_back({"Kd", num(s.gains.kd, 6)});
-    t.rows.push_back({"τ [s]", num(s.gains.tau, 4)});
+  if (s.full_order) {
+    const tuning::FullOrderSummary& f = *s.full_order;
+    t.rows.push_back({"compensator states", std::to_string(f.compensator.states())});
+    t.rows.push_back({"kbw", num(f.weights.kbw, 4)});
+    t.rows.push_back({"feedforward kff (normalized)", num(f.weights.feedforward, 4)});
+    t.rows.push_back({"compensator", f.controller_stable ? "stable" : "UNSTABLE (stable only in closed loop)"});
+  } else {
+    t.rows.push_back({"Kp", num(s.gains.kp, 6)});
+    t.rows.push_back({"Ki", num(s.gains.ki, 6)});
+    if (s.gains.kd != 0.0) {
+      t.rows.push_back({"Kd", num(s.gains.kd, 6)});
+      t.rows.push_back({"τ [s]", num(s.gains.tau, 4)});
+    }
+    t.rows.push_back({"setpoint weight wp", num(s.gains.wp, 4)});
   }
-  t.rows.push_back({"setpoint weight wp", num(s.gains.wp, 4)});
   if (s.kpp) t.rows.push_back({"Kpp [1/s]", num(*s.kpp, 6)});
   t.rows.push_back({"sample period [s]", num(s.ts, 6)});
   t.rows.push_back({"step", fmt::format("{} of {} {}", vcnc::to_string(s.test), num(s.amplitude),

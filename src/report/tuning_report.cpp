@@ -93,7 +93,11 @@ std::vector<double> frequency_grid(const tuning::TuneResult& r, std::size_t poin
   // The crossovers (where the HF dynamics act) stay inside the chart.
   for (double w : {i.gain_crossover, i.phase_crossover})
     if (std::isfinite(w)) top = std::max(top, 3.0 * w / kFactorAbove);
-  const double bottom = std::min(1.0, r.controller.design.omega_star) / kFactorBelow;
+  // A full-order design has no ω*: its motor bandwidth marks the low end instead.
+  double low = 1.0;
+  for (double w : {r.controller.design.omega_star, i.bandwidth_motor})
+    if (std::isfinite(w) && w > 0.0) low = std::min(low, w);
+  const double bottom = low / kFactorBelow;
   return with_exact_points(core::log_space(bottom, kFactorAbove * top, points), exact);
 }
 
@@ -345,6 +349,17 @@ Table scan_table(const Context& c) {
   return t;
 }
 
+Table kbw_scan_table(const Context& c) {
+  Table t;
+  t.title = "Automatic kbw scan";
+  t.header = {"kbw", "stable", "bandwidth [Hz]", "‖S‖∞", "tracking peak", "within the limits"};
+  for (const tuning::TuneResult::Candidate& k : c.result.scan) {
+    t.rows.push_back({num(k.omega_star, 4), yes_no(k.stable), k.stable ? num(c.to_hz(k.bandwidth)) : "-",
+                      k.stable ? num(k.peak_s, 4) : "-", k.stable ? num(k.peak_tracking, 4) : "-", yes_no(k.feasible)});
+  }
+  return t;
+}
+
 /// One row per real pole and per complex pair (upper member), by increasing modulus.
 Table poles_table(const Context& c) {
   std::vector<Complex> poles;
@@ -363,8 +378,57 @@ Table poles_table(const Context& c) {
   return t;
 }
 
+Table lqg_table(const Context& c) {
+  const tuning::FullOrderSummary& f = *c.controller.full_order;
+  const tuning::VelocityLqgOptions& w = f.weights;
+  Table t;
+  t.title = "LQG design (C7.13, normalized weights)";
+  t.header = {"parameter", "value", "note"};
+  t.rows.push_back({"kbw", num(w.kbw, 5), f.kbw_source});
+  t.rows.push_back({"feedforward kff", num(w.feedforward, 5),
+                    fmt::format("{} torque per velocity (model units); {}", num(w.feedforward * c.torque_per_velocity(), 5),
+                                f.feedforward_source)});
+  const double cc = c.plant.r * c.plant.r / 2.0;
+  t.rows.push_back({"control weight ρ = kbw/c², c = r²/2", num(w.kbw / (cc * cc), 5), "also the Q weight of the shaft torque"});
+  t.rows.push_back({"Q weight of ωl, of the integral", num(w.q_load_velocity, 4) + ", " + num(w.q_integral, 4), ""});
+  t.rows.push_back({"process noise into ωm, into Tl", num(w.noise_motor, 4) + ", " + num(w.noise_load_torque, 4), ""});
+  t.rows.push_back({"measurement noise V", num(w.measurement_noise, 4), ""});
+  t.rows.push_back({"motor velocity fed back", w.raw_motor_velocity ? "measured" : "estimated", ""});
+  t.rows.push_back({"compensator states", std::to_string(f.compensator.states()), ""});
+  t.rows.push_back({"compensator", f.controller_stable ? "stable" : "UNSTABLE", "stable only inside the closed loop when unstable"});
+  for (const Complex& p : f.controller_poles) {
+    if (p.imag() < 0.0) continue;
+    t.rows.push_back({"compensator pole", fmt::format("{} {} {}j", num(p.real(), 4), p.imag() > 0.0 ? "±" : "+", num(p.imag(), 4)),
+                      fmt::format("{} Hz", num(c.to_hz(std::abs(p)), 4))});
+  }
+  if (c.controller.discrete)
+    t.rows.push_back({"discretized (Tustin) at ts", num(c.controller.discrete->ts * 1e3, 5) + " ms", ""});
+  return t;
+}
+
+Section lqg_design_section(const Context& c) {
+  const tuning::Controller& k = c.controller;
+  Section s;
+  s.title = "Design";
+  s.text = fmt::format(
+      "Full-order velocity LQG (C7.13) on the first mode's two-mass realization: regulator on [ωm, ωl, Ts, ∫(ω* − ωm)], "
+      "Kalman filter on [ωm, ωl, Ts, Tl] from the motor velocity; kbw = {} ({}). Larger kbw makes control dearer "
+      "and the loop slower.",
+      num(k.full_order->weights.kbw, 4), k.full_order->kbw_source);
+  if (!c.result.scan.empty())
+    s.text += fmt::format(" The scan evaluated {} values of kbw from 1e3 (slow) to 1e-4 (fast), the boundary refined "
+                          "by bisection.",
+                          c.result.scan.size());
+  for (const std::string& note : k.notes) s.text += "\n\nNote: " + note;
+  s.tables.push_back(lqg_table(c));
+  if (!c.result.scan.empty()) s.tables.push_back(kbw_scan_table(c));
+  s.tables.push_back(poles_table(c));
+  return s;
+}
+
 Section design_section(const Context& c, bool load) {
   const tuning::Controller& k = c.controller;
+  if (k.full_order) return lqg_design_section(c);
   Section s;
   s.title = "Design";
   s.text = fmt::format(
@@ -494,6 +558,11 @@ Section robustness_section(const Context& c, const tuning::VelocityLoop& loop,
     t.rows.push_back({"NP: ‖S‖∞/Ms", num(rob.np, 5), num(c.to_hz(rob.np_omega)), yes_no(rob.np_ok)});
     t.rows.push_back({"RP: sup(|S|/Ms + |W2 T|)", num(rob.rp, 5), num(c.to_hz(rob.rp_omega)), yes_no(rob.rp_ok)});
   }
+  if (const std::optional<double> mt = c.controller.design.mt) {
+    const tuning::RobustTracking rt = tuning::robust_tracking(loop, *w2n, *mt);
+    t.rows.push_back({"robust tracking (C7.13): sup |ωm/ω*|(1 + |W2|)/(1 − |W2 T|)/Mt", num(rt.value, 5),
+                      num(c.to_hz(rt.omega)), yes_no(rt.ok())});
+  }
   s.tables.push_back(std::move(t));
 
   const std::size_t n = c.omega.size();
@@ -519,7 +588,7 @@ Section robustness_section(const Context& c, const tuning::VelocityLoop& loop,
 /// load side, else the first mode's two-mass loop).
 tuning::VelocityLoop position_base(const Context& c, const tuning::VelocityLoop& loop) {
   if (loop.has_load()) return loop;
-  return tuning::VelocityLoop(c.plant, c.controller.normalized, true, false);
+  return tuning::VelocityLoop(c.plant, tuning::normalized_controller(c.controller), true, false);
 }
 
 Section position_section(const Context& c, const tuning::VelocityLoop& base,
@@ -687,12 +756,14 @@ Document tuning_report(const tuning::TuneResult& result, const TuningReportOptio
   c.hz.reserve(c.omega.size());
   for (double w : c.omega) c.hz.push_back(c.to_hz(w));
 
-  const tuning::VelocityLoop loop(plant, result.controller.normalized);
+  const tuning::VelocityLoop loop(plant, tuning::normalized_controller(result.controller));
   Document doc;
   doc.title = "servotwin tune: " + tuning::to_string(result.controller.structure) + " controller";
-  doc.subtitle =
-      fmt::format("{}{}antiresonance {} Hz, r = {}, ω* = {} Hz", options.source, options.source.empty() ? "" : ": ",
-                  num(c.to_hz(1.0), 4), num(plant.r, 4), num(c.to_hz(result.controller.design.omega_star), 4));
+  const auto& f = result.controller.full_order;
+  doc.subtitle = fmt::format("{}{}antiresonance {} Hz, r = {}, {}", options.source, options.source.empty() ? "" : ": ",
+                             num(c.to_hz(1.0), 4), num(plant.r, 4),
+                             f ? fmt::format("kbw = {}", num(f->weights.kbw, 4))
+                               : fmt::format("ω* = {} Hz", num(c.to_hz(result.controller.design.omega_star), 4)));
   doc.sections.push_back(plant_section(c));
   doc.sections.push_back(design_section(c, loop.has_load()));
   doc.sections.push_back(loop_section(c, loop));

@@ -17,12 +17,16 @@ std::string to_string(Structure structure) {
       return "pid";
     case Structure::kPiP:
       return "pi+p";
+    case Structure::kLqg:
+      return "lqg";
   }
   return "pi";
 }
 
+bool is_full_order(Structure structure) noexcept { return structure == Structure::kLqg; }
+
 std::optional<Structure> structure_from_string(const std::string& name) {
-  for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP}) {
+  for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP, Structure::kLqg}) {
     if (to_string(s) == name) return s;
   }
   return std::nullopt;
@@ -55,7 +59,26 @@ core::StateSpace controller_state_space(const PidGains& g) {
   return sys;
 }
 
-core::DiscreteStateSpace discretize_controller(const PidGains& physical, double ts, std::optional<double> prewarp_rad_s) {
+core::StateSpace to_physical(const core::StateSpace& n, const PlantScales& plant) {
+  const double wz = plant.omega_z, torque = plant.motor_inertia * plant.omega_z;
+  return {wz * n.A, wz * n.B, torque * n.C, torque * n.D};
+}
+
+core::StateSpace controller_state_space(const Controller& c) {
+  if (!is_full_order(c.structure)) return controller_state_space(c.physical);
+  if (!c.full_order) throw std::invalid_argument("controller_state_space: a full-order controller without its compensator");
+  return to_physical(c.full_order->compensator, c.plant);
+}
+
+ControllerTf normalized_controller(const Controller& c) {
+  if (!is_full_order(c.structure)) return pid_controller(c.normalized);
+  if (!c.full_order) throw std::invalid_argument("normalized_controller: a full-order controller without its compensator");
+  return two_dof_form(c.full_order->compensator);
+}
+
+namespace {
+
+void check_period(double ts, std::optional<double> prewarp_rad_s) {
   if (!std::isfinite(ts) || ts <= 0.0) {
     throw core::InputError(core::at_field("ts"), "expected a sample period > 0 s, got " + std::to_string(ts));
   }
@@ -66,7 +89,19 @@ core::DiscreteStateSpace discretize_controller(const PidGains& physical, double 
                                " Hz must lie below the Nyquist frequency " +
                                std::to_string(nyquist / (2.0 * std::numbers::pi)) + " Hz: shorten the sample period");
   }
+}
+
+}  // namespace
+
+core::DiscreteStateSpace discretize_controller(const PidGains& physical, double ts, std::optional<double> prewarp_rad_s) {
+  check_period(ts, prewarp_rad_s);
   return core::discretize_tustin(controller_state_space(physical), ts, prewarp_rad_s);
+}
+
+core::DiscreteStateSpace discretize_controller(const Controller& controller, double ts,
+                                               std::optional<double> prewarp_rad_s) {
+  check_period(ts, prewarp_rad_s);
+  return core::discretize_tustin(controller_state_space(controller), ts, prewarp_rad_s);
 }
 
 }  // namespace servotwin::tuning

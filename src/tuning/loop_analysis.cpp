@@ -356,9 +356,6 @@ void mark_unstable(LoopIndices& out) {
   out.sample_time = out.horizon = kNaN;
 }
 
-/// |C(j∞)| = |kp + kd/τ| (kd/τ absent for a PI).
-double hf_limit(const PidGains& g) { return std::abs(g.kp + (g.kd != 0.0 ? g.kd / g.tau : 0.0)); }
-
 }  // namespace
 
 void validate(const AnalysisOptions& o) {
@@ -394,7 +391,7 @@ LoopIndices analyse(const VelocityLoop& loop, const AnalysisOptions& options) {
     out.min_damping = std::min(out.min_damping, std::abs(p) > 0.0 ? -p.real() / std::abs(p) : 1.0);
   out.closed_loop_stable = loop.stable();
   out.hf_controller_gain =
-      options.hf_gain_omega > 0.0 ? std::abs(loop.controller(options.hf_gain_omega)) : hf_limit(loop.gains());
+      options.hf_gain_omega > 0.0 ? std::abs(loop.controller(options.hf_gain_omega)) : loop.controller_hf_limit();
   if (!out.closed_loop_stable) {
     mark_unstable(out);
     return out;
@@ -406,6 +403,10 @@ LoopIndices analyse(const VelocityLoop& loop, const AnalysisOptions& options) {
 }
 
 LoopIndices analyse(const NormalizedPlant& plant, const PidGains& gains, const AnalysisOptions& options) {
+  return analyse(plant, pid_controller(gains), options);
+}
+
+LoopIndices analyse(const NormalizedPlant& plant, const ControllerTf& controller, const AnalysisOptions& options) {
   AnalysisOptions o = options;
   o.extra_frequencies.push_back(1.0);
   if (plant.r > 0.0) o.extra_frequencies.push_back(plant.r);
@@ -414,7 +415,7 @@ LoopIndices analyse(const NormalizedPlant& plant, const PidGains& gains, const A
     o.extra_frequencies.push_back(m.resonance.omega_rad_s);
   }
   if (o.hf_gain_omega <= 0.0) o.hf_gain_omega = 10.0 * plant.r;
-  return analyse(VelocityLoop(plant, gains), o);
+  return analyse(VelocityLoop(plant, controller), o);
 }
 
 

@@ -30,20 +30,6 @@ std::vector<Complex> poles_of(const Matrix& a) {
   return out;
 }
 
-bool stable_except_integrator(const std::vector<Complex>& poles) {
-  double scale = 1.0;
-  for (const Complex p : poles) scale = std::max(scale, std::abs(p));
-  bool integrator_seen = false;
-  for (const Complex p : poles) {
-    if (std::abs(p) <= kImaginaryAxisTolerance * scale && !integrator_seen) {
-      integrator_seen = true;  // the integral state of the compensator
-      continue;
-    }
-    if (p.real() >= -kImaginaryAxisTolerance * scale) return false;
-  }
-  return true;
-}
-
 void check_plant(const FrictionTwoMass& p, double r) {
   detail::require_positive(p.stiffness, "stiffness", "a shaft stiffness");
   detail::require_positive(p.load_inertia, "load_inertia", "a load inertia");
@@ -107,8 +93,8 @@ EstimatorModel estimator_model(const core::StateSpace& p) {
 /// estimator on the plant's states plus a constant load torque (y = first output); the design's
 /// gains and pole sets. `q` is the diagonal of Q over [plant states, xi]; `w` the process-noise
 /// intensity over [plant states, Tl].
-LqgDesign regulator_and_estimator(const core::StateSpace& p, const Eigen::VectorXd& q, double rho, const Matrix& w,
-                                  double v) {
+LqgDesign regulator_and_estimator(const core::StateSpace& p, const EstimatorModel& e, const Eigen::VectorXd& q,
+                                  double rho, const Matrix& w, double v) {
   const Eigen::Index n = p.A.rows();
   LqgDesign d;
   Matrix a = Matrix::Zero(n + 1, n + 1);
@@ -118,7 +104,6 @@ LqgDesign regulator_and_estimator(const core::StateSpace& p, const Eigen::Vector
   b.topRows(n) = p.B.col(0);
   d.regulator_gain = regulator(a, b, q.asDiagonal().toDenseMatrix(), rho, d.riccati_residual);
   d.regulator_poles = poles_of(a - b * d.regulator_gain);
-  const EstimatorModel e = estimator_model(p);
   d.estimator_gain = estimator(e.a, e.c, w, v, d.riccati_residual);
   d.estimator_poles = poles_of(e.a - d.estimator_gain * e.c);
   return d;
@@ -127,9 +112,9 @@ LqgDesign regulator_and_estimator(const core::StateSpace& p, const Eigen::Vector
 /// The compensator with states [x̂ (plant + Tl), xi], inputs [reference, y], output
 ///   u = −kx x̂ − K_xi xi − ky y + kref·reference,
 /// x̂' = Ae x̂ + Be u + L (y − Ce x̂), xi' = reference − y; its poles and the closed loop's.
-void finish(LqgDesign& d, const core::StateSpace& p, const Eigen::RowVectorXd& kx, double ky, double kref) {
+void finish(LqgDesign& d, const core::StateSpace& p, const EstimatorModel& e, const Eigen::RowVectorXd& kx, double ky,
+            double kref) {
   const Eigen::Index ne = p.A.rows() + 1;
-  const EstimatorModel e = estimator_model(p);
   const Matrix& ae = e.a;
   const Matrix& be = e.b;
   const Matrix& ce = e.c;
@@ -201,14 +186,15 @@ LqgDesign velocity_lqg(const FrictionTwoMass& plant, double r, const VelocityLqg
   Matrix w = Matrix::Zero(4, 4);
   w(0, 0) = o.noise_motor;
   w(3, 3) = o.noise_load_torque;
-  LqgDesign d = regulator_and_estimator(p, Eigen::Vector4d(0.0, o.q_load_velocity, rho, o.q_integral), rho, w,
+  const EstimatorModel e = estimator_model(p);
+  LqgDesign d = regulator_and_estimator(p, e, Eigen::Vector4d(0.0, o.q_load_velocity, rho, o.q_integral), rho, w,
                                         o.measurement_noise);
   // u = −K₁ x̂₁ − K₂ x̂₂ − K₃ x̂₃ − K₄ xi + kff ω* (K₁ on the measurement with raw_motor_velocity).
   Eigen::RowVectorXd kx = Eigen::RowVectorXd::Zero(4);
   kx.head(3) = d.regulator_gain.head(3);
   double ky = 0.0;
   if (o.raw_motor_velocity) std::swap(ky, kx(0));
-  finish(d, p, kx, ky, o.feedforward);
+  finish(d, p, e, kx, ky, o.feedforward);
   return d;
 }
 
@@ -221,13 +207,40 @@ LqgDesign position_lqg(const FrictionTwoMass& plant, double r, const PositionLqg
 
   const core::StateSpace p = two_mass_state_space(plant, true);
   const double rho = control_weight(o.kbw, r);
-  LqgDesign d = regulator_and_estimator(p, o.q, rho, o.process_noise * Matrix::Identity(5, 5), o.measurement_noise);
+  const EstimatorModel e = estimator_model(p);
+  LqgDesign d =
+      regulator_and_estimator(p, e, o.q, rho, o.process_noise * Matrix::Identity(5, 5), o.measurement_noise);
   // Error coordinates: u = −K₁(φ̂m − φ*) − K₂ ω̂m − K₃(φ̂l − φ*) − K₄ ω̂l − K₅ xi, so that a step of φ*
   // acts at once and the integral only removes what the load torque leaves.
   Eigen::RowVectorXd kx = Eigen::RowVectorXd::Zero(5);
   kx.head(4) = d.regulator_gain.head(4);
-  finish(d, p, kx, 0.0, d.regulator_gain(0) + d.regulator_gain(2));
+  finish(d, p, e, kx, 0.0, d.regulator_gain(0) + d.regulator_gain(2));
   return d;
+}
+
+bool stable_except_integrator(const std::vector<std::complex<double>>& poles) {
+  double scale = 1.0;
+  for (const Complex p : poles) scale = std::max(scale, std::abs(p));
+  bool integrator_seen = false;
+  for (const Complex p : poles) {
+    if (std::abs(p) <= kImaginaryAxisTolerance * scale && !integrator_seen) {
+      integrator_seen = true;  // the integral state of the compensator
+      continue;
+    }
+    if (p.real() >= -kImaginaryAxisTolerance * scale) return false;
+  }
+  return true;
+}
+
+ControllerTf two_dof_form(const core::StateSpace& c) {
+  if (c.inputs() != 2 || c.outputs() != 1)
+    throw std::invalid_argument("two_dof_form: expected a compensator with inputs [reference, y] and one output");
+  const core::TransferFunction reference = core::to_transfer_function(c, 0, 0);
+  const core::TransferFunction measurement = core::to_transfer_function(c, 0, 1);
+  // Both are over det(sI − Ac); the reference's copy is replaced by the feedback's so the loop
+  // algebra sees one denominator (they differ only by rounding).
+  const core::Polynomial& den = measurement.den();
+  return {core::TransferFunction(-1.0 * measurement.num(), den), core::TransferFunction(reference.num(), den)};
 }
 
 }  // namespace servotwin::tuning

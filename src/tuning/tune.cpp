@@ -40,6 +40,10 @@ void validate(const TuneOptions& o) {
   require(o.setpoint_weight >= 0.0 && o.setpoint_weight <= 1.0, "--setpoint-weight",
           fmt::format("expected a weight in [0, 1], got {}", o.setpoint_weight));
   require(o.scan_points >= 4 && o.scan_points <= 1000, "scan_points", "expected 4 to 1000 candidates");
+  if (o.kbw) require(std::isfinite(*o.kbw) && *o.kbw > 0.0, "--kbw", fmt::format("expected a knob > 0, got {}", *o.kbw));
+  if (o.feedforward)
+    require(std::isfinite(*o.feedforward) && *o.feedforward >= 0.0, "--kff",
+            fmt::format("expected a normalized feedforward gain >= 0, got {}", *o.feedforward));
   if (o.w2) {
     require(o.w2->is_proper(), "--w2", "the uncertainty weight must be proper (numerator degree <= denominator degree)");
     require(core::is_hurwitz(o.w2->den()), "--w2", "the uncertainty weight must be stable (poles in the left half-plane)");
@@ -101,9 +105,13 @@ struct SpecCheck {
   std::vector<double> bandwidth_grid;  // the grid with ω = 0 first (the DC reference of the bandwidth)
 
   [[nodiscard]] TuneResult::Candidate operator()(double omega_star, const PidGains& gains) const {
+    return (*this)(omega_star, VelocityLoop(plant, gains));
+  }
+
+  /// The spec of the loop; `parameter` is recorded as the candidate's ω* (lqg: kbw).
+  [[nodiscard]] TuneResult::Candidate operator()(double parameter, const VelocityLoop& loop) const {
     TuneResult::Candidate c;
-    c.omega_star = omega_star;
-    const VelocityLoop loop(plant, gains);
+    c.omega_star = parameter;
     c.stable = loop.stable();
     if (!c.stable) return c;
     c.peak_s = core::peak_on_grid([&](double w) { return loop.sensitivity(w); }, grid, 1e-4).value;
@@ -112,8 +120,18 @@ struct SpecCheck {
     c.peak_tracking = core::peak_on_grid(tracking, grid, 1e-4).value;
     c.bandwidth = core::bandwidth(tracking, bandwidth_grid).value_or(0.0);
     c.feasible = c.peak_s <= options.ms && c.peak_tracking <= options.mt;
-    if (c.feasible && w2) c.feasible = robustness(loop, *w2, options.ms, scan_robustness_options()).rp_ok;
+    if (c.feasible && w2) c.feasible = robust(loop);
     return c;
+  }
+
+ private:
+  /// PI/PID: RP of the disturbance type (uncertainty.hpp); lqg: RS and C7.13's robust tracking,
+  /// with a margin for the scan grid's resolution: the bisections of kbw and kff end on the
+  /// boundary, and the final test on the fine grid must still pass there.
+  [[nodiscard]] bool robust(const VelocityLoop& loop) const {
+    if (options.structure != Structure::kLqg) return robustness(loop, *w2, options.ms, scan_robustness_options()).rp_ok;
+    constexpr double kScanGridMargin = 1e-3;
+    return robust_tracking(loop, *w2, options.mt, scan_robustness_options()).value < 1.0 - kScanGridMargin;
   }
 };
 
@@ -125,9 +143,10 @@ struct SpecCheck {
 }
 
 /// The largest-bandwidth feasible candidate, its boundary with the next infeasible one refined
-/// by bisection (feasibility usually ends at a peak limit reached as ω* grows).
-TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, const GainDesigner& design,
-                             const SpecCheck& check) {
+/// by bisection (feasibility usually ends at a peak limit reached as the loop gets faster).
+/// `evaluate(parameter)` gives the candidate of one parameter (ω*, or kbw for lqg).
+template <class Evaluate>
+TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Evaluate&& evaluate) {
   std::size_t best = scan.size();
   for (std::size_t i = 0; i < scan.size(); ++i) {
     if (scan[i].feasible && (best == scan.size() || scan[i].bandwidth > scan[best].bandwidth)) best = i;
@@ -138,7 +157,7 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, con
     double lo = scan[best].omega_star, hi = scan[best + 1].omega_star;
     for (int it = 0; it < 12; ++it) {
       const double mid = std::sqrt(lo * hi);
-      const TuneResult::Candidate c = check(mid, design(mid));
+      const TuneResult::Candidate c = evaluate(mid);
       if (c.feasible) {
         lo = mid;
         if (c.bandwidth > chosen.bandwidth) chosen = c;
@@ -159,15 +178,23 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, con
       at = c.omega_star;
     }
   }
+  const bool lqg = o.structure == Structure::kLqg;
+  const char* parameter = lqg ? "kbw" : "omega*";
   if (!std::isfinite(best_s)) {
     throw InputError(at_field("--structure"),
-                     "no omega* in the admissible range gives a stable loop with the known HF dynamics: "
-                     "reduce the delay/lags or use a slower structure");
+                     fmt::format("no {} in the {} gives a stable loop with the known HF dynamics: reduce the "
+                                 "delay/lags or use a slower structure",
+                                 parameter, lqg ? "range [1e-4, 1e3]" : "admissible range"));
   }
   throw InputError(at_field(o.w2 ? "--w2" : "--ms"),
-                   fmt::format("no omega* meets ||S|| <= {} and the tracking peak <= {}{}: the best achievable are "
-                               "||S|| = {:.3g} and {:.3g} at omega*/omega_z = {:.3g}; relax --ms/--mt",
-                               o.ms, o.mt, o.w2 ? " with robust performance" : "", best_s, best_t, at));
+                   fmt::format("no {} meets ||S|| <= {} and the tracking peak <= {}{}: the best achievable are "
+                               "||S|| = {:.3g} and {:.3g} at {} = {:.3g}; relax --ms/--mt",
+                               parameter, o.ms, o.mt,
+                               !o.w2 ? ""
+                               : lqg ? " with robust stability and robust tracking (C7.13)"
+                                     : " with robust performance",
+                               best_s, best_t,
+                               lqg ? "kbw" : "omega*/omega_z", at));
 }
 
 PlantScales scales(const NormalizedPlant& p) { return {p.omega_z, p.motor_inertia, p.r, p.zeta_z, p.zeta_p, p.a}; }
@@ -181,7 +208,7 @@ std::optional<double> prewarp_frequency(const Controller& c, double ts) {
 
 void add_discrete(Controller& c, double ts) {
   c.prewarp_rad_s = prewarp_frequency(c, ts);
-  c.discrete = discretize_controller(c.physical, ts, c.prewarp_rad_s);
+  c.discrete = discretize_controller(c, ts, c.prewarp_rad_s);
   if (c.physical.kd != 0.0 && ts / c.physical.tau > 0.5) {
     c.notes.push_back(fmt::format("the derivative filter tau = {:.3g} s is short against ts = {:.3g} s: "
                                   "its discrete pole is poorly resolved; increase --tau",
@@ -236,20 +263,147 @@ void add_position_loop(Controller& c, const VelocityLoop& loop, const std::optio
   c.position = p;
 }
 
-}  // namespace
 
-TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
-  validate(options);
-  TuneResult result;
-  result.plant = normalize(model, options.hf);
-  const NormalizedPlant& plant = result.plant;
-  result.advice = advise(plant.r, options.zeta_star);
-  if (plant.r < kRatioForPassiveMethods) {
-    throw InputError(at_field("plant"),
-                     fmt::format("resonance ratio r = {:.3f} < {}: a PI/PID cannot damp this mode (catalog C7.4); "
-                                 "recommend passive methods: a notch filter or an input shaper (servotwin shaper)",
-                                 plant.r, kRatioForPassiveMethods));
+/// RS, NP, RP and C7.13's robust tracking of the final design on the fine grid.
+void add_robustness(Controller& c, const VelocityLoop& loop, const core::TransferFunction& w2, const TuneOptions& o) {
+  const RobustnessResult rob = robustness(loop, w2, o.ms);
+  c.robustness.rs = rob.rs;
+  c.robustness.np = rob.np;
+  c.robustness.rp = rob.rp;
+  c.robustness.rp_tracking = robust_tracking(loop, w2, o.mt).value;
+  if (!rob.rs_ok) c.notes.push_back("robust stability FAILS for the given W2 (||W2 T|| >= 1)");
+}
+
+// ------------------------------------------------------------------------------------- lqg
+
+/// kbw candidates of the automatic search, from slow to fast (C7.13: a larger kbw is slower).
+constexpr double kKbwSlowest = 1e3, kKbwFastest = 1e-4;
+constexpr std::size_t kKbwPoints = 36;
+/// The automatic feedforward stops doubling here (normalized torque per velocity).
+constexpr double kFeedforwardCap = 1e3;
+constexpr int kFeedforwardBisections = 40;
+
+/// The C7.13 velocity LQG of the user's weights at one (kbw, kff), and its loop.
+struct LqgDesigner {
+  const NormalizedPlant& plant;
+  FrictionTwoMass model;
+  VelocityLqgOptions weights;
+
+  [[nodiscard]] LqgDesign design(double kbw, double kff) const {
+    VelocityLqgOptions w = weights;
+    w.kbw = kbw;
+    w.feedforward = kff;
+    return velocity_lqg(model, plant.r, w);
   }
+  [[nodiscard]] VelocityLoop loop(const LqgDesign& d) const { return VelocityLoop(plant, two_dof_form(d.compensator)); }
+};
+
+/// The first mode's two-mass realization with friction: the LQG's design model.
+FrictionTwoMass lqg_design_model(const NormalizedPlant& plant) {
+  NormalizedPlant first = plant;
+  first.higher_modes.clear();
+  const std::optional<FrictionTwoMass> m = physical_parameters_with_friction(first);
+  if (!m) {
+    throw InputError(at_field("--structure"),
+                     "lqg needs a two-mass realization with non-negative friction, and this plant has none (its "
+                     "friction terms would be negative); use --structure pi or pid");
+  }
+  return *m;
+}
+
+std::vector<double> kbw_candidates() {
+  std::vector<double> k = core::log_space(kKbwFastest, kKbwSlowest, kKbwPoints);
+  std::reverse(k.begin(), k.end());
+  return k;
+}
+
+/// The smallest kbw (fastest loop) meeting the spec, from the scan and a bisection at its boundary.
+double automatic_kbw(const LqgDesigner& lqg, const SpecCheck& check, TuneResult& result) {
+  const auto evaluate = [&](double kbw) { return check(kbw, lqg.loop(lqg.design(kbw, 0.0))); };
+  for (double kbw : kbw_candidates()) result.scan.push_back(evaluate(kbw));
+  const TuneResult::Candidate chosen = choose(result.scan, evaluate);
+  if (!chosen.feasible) no_feasible_omega(result.scan, check.options);
+  return chosen.omega_star;
+}
+
+/// The largest kff in [0, kFeedforwardCap] keeping the spec (C7.13: the tracking peak <= Mt):
+/// doubling to the first failure, then bisection. 0 when the loop misses the spec without it.
+double automatic_feedforward(const LqgDesigner& lqg, const SpecCheck& check, double kbw, std::string& source) {
+  const auto feasible = [&](double kff) { return check(kbw, lqg.loop(lqg.design(kbw, kff))).feasible; };
+  if (!feasible(0.0)) {
+    source = "none: the loop misses the spec already without feedforward";
+    return 0.0;
+  }
+  double lo = 0.0, hi = 0.125;
+  while (hi < kFeedforwardCap && feasible(hi)) {
+    lo = hi;
+    hi *= 2.0;
+  }
+  if (hi >= kFeedforwardCap && feasible(hi)) {
+    source = fmt::format("capped at {:g}: the spec never binds", kFeedforwardCap);
+    return hi;
+  }
+  for (int it = 0; it < kFeedforwardBisections; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (feasible(mid) ? lo : hi) = mid;
+  }
+  source = check.w2 ? "largest keeping the tracking peak <= Mt and robust tracking"
+                    : "largest keeping the tracking peak <= Mt";
+  return lo;
+}
+
+std::string pole_list(const std::vector<std::complex<double>>& poles) {
+  std::string out;
+  for (const std::complex<double>& p : poles) {
+    if (p.imag() < 0.0) continue;  // one of each conjugate pair
+    out += (out.empty() ? "" : ", ") + (p.imag() > 0.0 ? fmt::format("{:.3g} ± {:.3g}j", p.real(), p.imag())
+                                                        : fmt::format("{:.3g}", p.real()));
+  }
+  return out;
+}
+
+/// The LQG path of tune(): kbw and kff, the compensator, its analysis and robustness.
+void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
+  const NormalizedPlant& plant = result.plant;
+  const LqgDesigner lqg{plant, lqg_design_model(plant), options.lqg};
+  Controller& c = result.controller;
+  FullOrderSummary f;
+  f.weights = options.lqg;
+  if (options.kbw) {
+    f.weights.kbw = *options.kbw;
+    f.kbw_source = "given";
+  } else {
+    f.weights.kbw = automatic_kbw(lqg, check, result);
+    f.kbw_source = options.w2 ? "smallest (fastest) with ||S|| <= Ms, tracking peak <= Mt and robust tracking"
+                              : "smallest (fastest) with ||S|| <= Ms and tracking peak <= Mt";
+  }
+  if (options.feedforward) {
+    f.weights.feedforward = *options.feedforward;
+    f.feedforward_source = "given";
+  } else {
+    f.weights.feedforward = automatic_feedforward(lqg, check, f.weights.kbw, f.feedforward_source);
+  }
+  const LqgDesign d = lqg.design(f.weights.kbw, f.weights.feedforward);
+  f.compensator = d.compensator;
+  f.controller_poles = d.controller_poles;
+  f.controller_stable = d.controller_stable;
+  c.full_order = std::move(f);
+  const ControllerTf tf = two_dof_form(d.compensator);
+  c.predicted = analyse(plant, tf);
+  if (!c.predicted.closed_loop_stable)
+    c.notes.push_back("the loop with the known HF dynamics is UNSTABLE at this kbw: choose a larger one");
+  if (!d.controller_stable) {
+    c.notes.push_back(fmt::format("the LQG compensator is itself UNSTABLE (poles {}, normalized): the loop is stable "
+                                  "only while closed; switch it on in closed loop and keep the torque limit out of "
+                                  "reach (saturation opens the loop)",
+                                  pole_list(d.controller_poles)));
+  }
+  if (check.w2) add_robustness(c, VelocityLoop(plant, tf), *check.w2, options);
+}
+
+/// The cascade path of tune() (pi, pid, pi+p): ω*, the gains, their analysis and robustness.
+void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
+  const NormalizedPlant& plant = result.plant;
   const GainDesigner design{plant, options};
   const double kd = options.structure == Structure::kPid ? virtual_inertia_kd(plant.r, options.target_r) : 0.0;
   result.range = admissible_range(plant, options.zeta_star, kd);
@@ -259,18 +413,8 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
                                  "slower than the assigned one everywhere); lower --zeta-star",
                                  options.zeta_star, plant.r));
   }
-  std::optional<core::TransferFunction> w2_normalized;
-  if (options.w2) w2_normalized = to_normalized_time(*options.w2, plant.omega_z);
-  const std::vector<double> grid = scan_grid(plant);
-  std::vector<double> bandwidth_grid{0.0};
-  bandwidth_grid.insert(bandwidth_grid.end(), grid.begin(), grid.end());
-  const SpecCheck check{plant, options, w2_normalized, grid, bandwidth_grid};
   Controller& c = result.controller;
-  c.structure = options.structure;
-  c.plant = scales(plant);
   c.design.zeta_star = options.zeta_star;
-  c.design.ms = options.ms;
-  c.design.mt = options.mt;
   if (options.structure == Structure::kPid) c.design.r_target = options.target_r;
 
   if (options.omega_star) {
@@ -285,7 +429,7 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
     c.design.omega_star_source = "given";
   } else {
     for (double w : candidates(result.range, options.scan_points)) result.scan.push_back(check(w, design(w)));
-    const TuneResult::Candidate chosen = choose(result.scan, design, check);
+    const TuneResult::Candidate chosen = choose(result.scan, [&](double w) { return check(w, design(w)); });
     if (!chosen.feasible) no_feasible_omega(result.scan, options);
     c.design.omega_star = chosen.omega_star;
     c.design.omega_star_source = options.w2 ? "largest load bandwidth with ||S|| <= Ms, peak <= Mt and robust performance"
@@ -298,15 +442,42 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   if (!c.predicted.closed_loop_stable) {
     c.notes.push_back("the loop with the known HF dynamics is UNSTABLE at this omega*: choose a smaller one");
   }
-  if (check.w2) {
-    const RobustnessResult rob = robustness(loop, *check.w2, options.ms);
-    c.robustness.rs = rob.rs;
-    c.robustness.np = rob.np;
-    c.robustness.rp = rob.rp;
-    if (!rob.rs_ok) c.notes.push_back("robust stability FAILS for the given W2 (||W2 T|| >= 1)");
-  }
+  if (check.w2) add_robustness(c, loop, *check.w2, options);
   if (options.structure == Structure::kPiP) add_position_loop(c, loop, check.w2, plant);
   if (!result.advice.verdict.empty()) c.notes.push_back(result.advice.verdict);
+}
+
+}  // namespace
+
+TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
+  validate(options);
+  TuneResult result;
+  result.plant = normalize(model, options.hf);
+  const NormalizedPlant& plant = result.plant;
+  result.advice = advise(plant.r, options.zeta_star);
+  if (plant.r < kRatioForPassiveMethods) {
+    throw InputError(at_field("plant"),
+                     fmt::format("resonance ratio r = {:.3f} < {}: a PI/PID cannot damp this mode (catalog C7.4) and "
+                                 "a full-order design gains little; recommend passive methods: a notch filter or an "
+                                 "input shaper (servotwin shaper)",
+                                 plant.r, kRatioForPassiveMethods));
+  }
+  std::optional<core::TransferFunction> w2_normalized;
+  if (options.w2) w2_normalized = to_normalized_time(*options.w2, plant.omega_z);
+  const std::vector<double> grid = scan_grid(plant);
+  std::vector<double> bandwidth_grid{0.0};
+  bandwidth_grid.insert(bandwidth_grid.end(), grid.begin(), grid.end());
+  const SpecCheck check{plant, options, w2_normalized, grid, bandwidth_grid};
+  Controller& c = result.controller;
+  c.structure = options.structure;
+  c.plant = scales(plant);
+  c.design.ms = options.ms;
+  c.design.mt = options.mt;
+  if (options.structure == Structure::kLqg) {
+    tune_lqg(result, options, check);
+  } else {
+    tune_cascade(result, options, check);
+  }
   if (!plant.higher_modes.empty()) {
     c.notes.push_back(fmt::format("designed on the first mode; {} higher mode(s) are included in every index",
                                   plant.higher_modes.size()));

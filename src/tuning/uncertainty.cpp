@@ -372,6 +372,34 @@ RobustnessResult robustness(const VelocityLoop& loop, const TransferFunction& w2
   return evaluate(loop, w2, ms, options);
 }
 
+RobustTracking robust_tracking(const VelocityLoop& loop, const TransferFunction& w2, double mt,
+                               const RobustnessOptions& options) {
+  if (!std::isfinite(mt) || mt < 1.0)
+    throw InputError(core::at_field("mt"), "expected a tracking peak limit M_T >= 1, got " + show(mt));
+  check_weight(w2);
+  check_options(options);
+  RobustTracking out;
+  out.value = std::numeric_limits<double>::infinity();
+  if (!loop.stable()) return out;
+  const std::vector<double> grid = robustness_grid(loop, w2, options);
+  const auto wt = [&](double w) { return w2.frequency_response(w) * loop.complementary(w); };
+  const core::PeakResult rs = core::peak_on_grid(wt, grid, options.rel_tol);
+  if (!(rs.value < 1.0)) {
+    out.omega = rs.omega_rad_s;
+    return out;
+  }
+  // Finite on the whole grid: |W2 T| < 1 everywhere (its refined supremum is).
+  const auto bound = [&](double w) {
+    const double gain = std::abs(loop.motor_tracking(w)) * (1.0 + std::abs(w2.frequency_response(w))) /
+                        (1.0 - std::abs(wt(w)));
+    return std::complex<double>(gain / mt, 0.0);
+  };
+  const core::PeakResult peak = core::peak_on_grid(bound, grid, options.rel_tol);
+  out.value = peak.value;
+  out.omega = peak.omega_rad_s;
+  return out;
+}
+
 std::string to_string(UncertaintyLimit limit) {
   switch (limit) {
     case UncertaintyLimit::kAdmissibleRange: return "admissible range";

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace servotwin::tuning {
@@ -30,6 +31,15 @@ NormalizedPlant design_plant(const NormalizedPlant& plant, bool with_higher_mode
   NormalizedPlant p = plant;
   if (!with_higher_modes) p.higher_modes.clear();
   return p;
+}
+
+/// The loop algebra assumes one proper controller denominator for both paths.
+void check_controller(const ControllerTf& c) {
+  const Polynomial& den = c.feedback.den();
+  if (!(c.reference.den() == den))
+    throw std::invalid_argument("VelocityLoop: the reference and feedback paths must share one denominator");
+  if (c.feedback.num().degree() > den.degree() || c.reference.num().degree() > den.degree())
+    throw std::invalid_argument("VelocityLoop: the controller must be proper");
 }
 
 }  // namespace
@@ -93,7 +103,12 @@ struct VelocityLoop::Values {
 
 VelocityLoop::VelocityLoop(const NormalizedPlant& plant, const PidGains& gains, bool with_hf, bool with_higher_modes,
                            int pade_order)
-    : gains_(gains), controller_(pid_controller(gains)), pade_order_(pade_order), r_(plant.r) {
+    : VelocityLoop(plant, pid_controller(gains), with_hf, with_higher_modes, pade_order) {}
+
+VelocityLoop::VelocityLoop(const NormalizedPlant& plant, ControllerTf controller, bool with_hf, bool with_higher_modes,
+                           int pade_order)
+    : controller_(std::move(controller)), pade_order_(pade_order), r_(plant.r) {
+  check_controller(controller_);
   if (!(plant.r > 1.0) || !std::isfinite(plant.r)) {
     throw std::invalid_argument("VelocityLoop: the plant's resonance ratio must be > 1 (use normalize())");
   }
@@ -124,6 +139,13 @@ VelocityLoop::VelocityLoop(const NormalizedPlant& plant, const PidGains& gains, 
   }
   const TransferFunction pade = pade_delay(delay_, pade_order_);
   characteristic_ = characteristic(pade.num(), pade.den());
+}
+
+double VelocityLoop::controller_hf_limit() const noexcept {
+  const Polynomial& num = controller_.feedback.num();
+  const Polynomial& den = controller_.feedback.den();
+  if (num.degree() < den.degree()) return 0.0;
+  return std::abs(num.coefficient_of_power(num.degree()) / den.coefficient_of_power(den.degree()));
 }
 
 Polynomial VelocityLoop::characteristic(const Polynomial& delay_num, const Polynomial& delay_den) const {

@@ -325,10 +325,11 @@ DriveSimulation simulate_drive(const machine::PlantConfig& plant, const tuning::
   out.torque_limit = settings.torque_limit;
   out.settling_band = settings.settling_band;
   out.gains = controller.physical;
+  out.full_order = controller.full_order;
   const auto* chain = std::get_if<machine::MassChain>(&plant.model);
   out.load_side = chain != nullptr && chain->masses() >= 2;
   compare_scales(plant, controller, out.notes);
-  out.controller = tuning::discretize_controller(controller.physical, out.ts, usable_prewarp(controller, out.ts, out.notes));
+  out.controller = tuning::discretize_controller(controller, out.ts, usable_prewarp(controller, out.ts, out.notes));
 
   const std::optional<double> kpp = is_position_loop(controller) ? controller.kpp_physical : std::nullopt;
   out.kpp = kpp;

@@ -43,6 +43,25 @@ TEST_F(Cli, SimulateRunsTheTunedControllerOnThePlantItWasTunedFrom) {
   EXPECT_NEAR(std::stod(cells[9]), 3.6, 0.02);
 }
 
+TEST_F(Cli, TuneLqgAndSimulateIt) {
+  // `tune --structure lqg` writes the compensator; `simulate` runs it on the preset with its
+  // friction: the integral state balances the same 0.5 + 3.6 = 4.1 N m as the PI above.
+  const Result t = run("tune table-5.1 --structure lqg -o lqg.json --report lqg.html");
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("structure lqg (C7.13, 5 states): kbw = "), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("compensator: "), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("verified by simulation"), std::string::npos) << t.out;
+  EXPECT_NE(slurp(path("lqg.html")).find("LQG design (C7.13"), std::string::npos);
+  const Result r = run("simulate --controller lqg.json --duration 30 -o step.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string csv = slurp(path("step.csv"));
+  EXPECT_EQ(csv.rfind("# servotwin.drive-simulation/1 test=step structure=lqg", 0), 0U) << csv.substr(0, 80);
+  const auto cells = last_row(csv);
+  ASSERT_EQ(cells.size(), 14U);
+  EXPECT_NEAR(std::stod(cells[3]), 4.1, 0.02);
+  EXPECT_NEAR(std::stod(cells[5]), 1.0, 0.005);
+}
+
 TEST_F(Cli, SimulateLoadStepWithATorqueLimit) {
   ASSERT_EQ(run("tune table-5.1 -o pi.json").status, 0);
   const Result r = run("simulate --plant table-5.1 --controller pi.json --test load-step --amplitude 4 "

@@ -78,8 +78,14 @@ TEST_F(Cli, TuneExplainsWhatItCannotDo) {
   r = run("tune no-such-plant");
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("presets"), std::string::npos) << r.err;
-  r = run("tune e26.json --structure lqg");
+  r = run("tune e26.json --structure hinf");
   EXPECT_EQ(r.status, 2);  // not offered yet: a usage error listing the structures
+  r = run("tune e26.json --structure lqg --kbw fast");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("--kbw"), std::string::npos) << r.err;
+  r = run("tune e26.json --structure lqg --kff -1");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("--kff"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, TuneWithAnUncertaintyWeightFromTheFitResiduals) {

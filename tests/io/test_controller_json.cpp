@@ -195,6 +195,27 @@ void expect_round_trip(const Controller& c, const Controller& b) {
   EXPECT_EQ(b.robustness.rs, c.robustness.rs);
   EXPECT_EQ(b.robustness.np, c.robustness.np);
   EXPECT_EQ(b.robustness.rp, c.robustness.rp);
+  EXPECT_EQ(b.robustness.rp_tracking, c.robustness.rp_tracking);
+  ASSERT_EQ(b.full_order.has_value(), c.full_order.has_value());
+  if (c.full_order) {
+    const tuning::FullOrderSummary &f = *b.full_order, &g = *c.full_order;
+    EXPECT_EQ(f.weights.kbw, g.weights.kbw);
+    EXPECT_EQ(f.weights.feedforward, g.weights.feedforward);
+    EXPECT_EQ(f.weights.q_load_velocity, g.weights.q_load_velocity);
+    EXPECT_EQ(f.weights.q_integral, g.weights.q_integral);
+    EXPECT_EQ(f.weights.noise_motor, g.weights.noise_motor);
+    EXPECT_EQ(f.weights.noise_load_torque, g.weights.noise_load_torque);
+    EXPECT_EQ(f.weights.measurement_noise, g.weights.measurement_noise);
+    EXPECT_EQ(f.weights.raw_motor_velocity, g.weights.raw_motor_velocity);
+    EXPECT_EQ(f.kbw_source, g.kbw_source);
+    EXPECT_EQ(f.feedforward_source, g.feedforward_source);
+    EXPECT_EQ(f.compensator.A, g.compensator.A);
+    EXPECT_EQ(f.compensator.B, g.compensator.B);
+    EXPECT_EQ(f.compensator.C, g.compensator.C);
+    EXPECT_EQ(f.compensator.D, g.compensator.D);
+    EXPECT_EQ(f.controller_poles, g.controller_poles);
+    EXPECT_EQ(f.controller_stable, g.controller_stable);
+  }
   ASSERT_EQ(b.discrete.has_value(), c.discrete.has_value());
   if (c.discrete) {
     EXPECT_EQ(b.discrete->ts, c.discrete->ts);
@@ -301,6 +322,53 @@ TEST(ControllerJsonRoundTrip, ControllersFromTheTuner) {
     ASSERT_TRUE(c.discrete.has_value());
     const LoadedController back = parse_controller_json(controller_to_json(c, "two_mass.json").dump(), "c.json");
     expect_round_trip(c, back.controller);
+  }
+}
+
+/// An LQG from the tuner (r = 3, 40 Hz antiresonance, Im = 4 g·m², 8 kHz), with W2 so that the
+/// robust-tracking number is filled.
+Controller lqg_controller() {
+  fit::PlantModel model;
+  model.rigid = fit::RigidKind::kIntegrator;
+  model.gain = 250.0;
+  const double wz = kTwoPi * 40.0;
+  model.modes = {{{wz, 0.01}, {3.0 * wz, 3.0 * 0.01}}};
+  tuning::TuneOptions o;
+  o.structure = Structure::kLqg;
+  o.ts = kTs;
+  o.w2 = core::TransferFunction(core::Polynomial{1.0 / (3.0 * wz), 0.1}, core::Polynomial{1.0 / (3.0 * wz), 1.0});
+  return tuning::tune(model, o).controller;
+}
+
+TEST(ControllerJsonRoundTrip, LqgFromTheTuner) {
+  const Controller c = lqg_controller();
+  ASSERT_TRUE(c.full_order.has_value());
+  ASSERT_TRUE(c.robustness.rp_tracking.has_value());
+  const nlohmann::json j = controller_to_json(c, "two_mass.json");
+  EXPECT_TRUE(j["gains"].is_null());
+  EXPECT_TRUE(j["normalized"].is_null());
+  EXPECT_TRUE(j["design"]["omega_star"].is_null());
+  EXPECT_EQ(j["lqg"]["compensator"]["A"].size(), 5U);
+  const LoadedController back = parse_controller_json(j.dump(), "lqg.json");
+  expect_round_trip(c, back.controller);
+  // The physical state space is the normalized compensator with time by ωz, torque by Im ωz (§0).
+  const double wz = c.plant.omega_z, torque = c.plant.motor_inertia * wz;
+  for (const double w : {0.3 * wz, wz, 3.0 * wz}) {
+    const Eigen::MatrixXcd n = core::frequency_response(c.full_order->compensator, w / wz);
+    for (Eigen::Index k = 0; k < 2; ++k) {
+      const std::complex<double> physical = [&] {
+        const auto& ss = j["state_space"];
+        Eigen::MatrixXd a(5, 5), b(5, 2), cc(1, 5), d(1, 2);
+        for (int r = 0; r < 5; ++r) {
+          for (int q = 0; q < 5; ++q) a(r, q) = ss["A"][r][q];
+          for (int q = 0; q < 2; ++q) b(r, q) = ss["B"][r][q];
+          cc(0, r) = ss["C"][0][r];
+        }
+        d << ss["D"][0][0].get<double>(), ss["D"][0][1].get<double>();
+        return core::frequency_response(core::StateSpace{a, b, cc, d}, w)(0, k);
+      }();
+      EXPECT_LE(std::abs(physical - torque * n(0, k)), 1e-9 * std::abs(physical)) << w;
+    }
   }
 }
 
@@ -518,8 +586,8 @@ TEST_F(ControllerJsonErrors, SamplePeriodAndPrewarp) {
 }
 
 TEST_F(ControllerJsonErrors, StructureAndLoop) {
-  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"pi\", \"pid\" or \"pi+p\"");
-  expect(with([](auto& c) { c["structure"] = "lqg"; }), "structure", "lqg");
+  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"pi\", \"pid\", \"pi+p\" or \"lqg\"");
+  expect(with([](auto& c) { c["structure"] = "lqg"; }), "gains", "expected null for an \"lqg\" controller");
   expect(with([](auto& c) { c["loop"] = "position"; }), "loop", "velocity loop");
   expect(with([](auto& c) { c["loop"] = "velocity"; }, Structure::kPiP), "loop", "position loop");
   expect(with([](auto& c) { c["loop"] = "current"; }), "loop", "\"velocity\" or \"position\"");
@@ -534,6 +602,30 @@ TEST_F(ControllerJsonErrors, StructureAndLoop) {
   expect(with([](auto& c) { c["structure"] = "pi"; }), "gains.kd", "only \"pid\" has a derivative");
   expect(with([](auto& c) { c["gains"]["tau"] = 0.0; }), "gains.tau", "derivative filter time constant > 0");
   expect(with([](auto& c) { c["gains"]["wd"] = 1.5; }), "gains.wd", "[0, 1]");
+}
+
+TEST_F(ControllerJsonErrors, LqgDocuments) {
+  static const nlohmann::json lqg = controller_to_json(lqg_controller(), "p.json");
+  const auto edited = [](auto edit) {
+    nlohmann::json copy = lqg;
+    edit(copy);
+    return error_of(copy.dump());
+  };
+  EXPECT_EQ(edited([](auto&) {}).message, "no error");
+  expect(edited([](auto& c) { c["lqg"]["controller_poles"][0][0] = 99.0; }), "lqg.controller_poles[0]",
+         "not an eigenvalue");
+  expect(edited([](auto& c) { c["lqg"]["compensator"]["B"][1][1] = 7.0; }), "state_space", "does not realize");
+  expect(edited([](auto& c) { c["state_space"]["D"][0][0] = 0.0; }), "state_space", "does not realize");
+  expect(edited([](auto& c) { c["discrete"]["C"][0][2] = 0.0; }), "discrete", "does not realize");
+  expect(edited([](auto& c) { c["lqg"]["controller_stable"] = !c["lqg"]["controller_stable"].template get<bool>(); }),
+         "lqg.controller_stable", "contradicts");
+  expect(edited([](auto& c) { c["lqg"] = nullptr; }), "lqg", "needs its compensator");
+  expect(edited([](auto& c) { c["lqg"]["kbw"] = 0.0; }), "lqg.kbw", "> 0");
+  expect(edited([](auto& c) { c["lqg"]["compensator"]["inputs"] = {"a", "b"}; }), "lqg.compensator.inputs",
+         "velocity_reference");
+  expect(edited([](auto& c) { c["design"]["omega_star"] = 0.5; }), "design.omega_star", "expected null");
+  expect(edited([](auto& c) { c["gains"] = c["state_space"]; }), "gains", "expected null");
+  expect(with([](auto& c) { c["lqg"] = {{"kbw", 1.0}}; }), "lqg", "only an \"lqg\" controller");
 }
 
 TEST_F(ControllerJsonErrors, PlantDesignAndDerivedMembers) {

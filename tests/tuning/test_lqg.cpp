@@ -13,7 +13,10 @@
 
 #include "fixture.hpp"
 #include "json_fixture.hpp"
+#include "servotwin/core/norms.hpp"
+#include "servotwin/core/transfer_function.hpp"
 #include "servotwin/tuning/lqg.hpp"
+#include "servotwin/tuning/velocity_loop.hpp"
 
 namespace servotwin::tuning {
 namespace {
@@ -161,6 +164,59 @@ TEST(Lqg, PositionDesignsMatchScipy) {
     }
     expect_same_roots(d.regulator_poles, roots_of(c.at("lqr_poles")), 1e-7, "regulator");
     expect_same_roots(d.estimator_poles, roots_of(c.at("kf_poles")), 1e-7, "estimator");
+  }
+}
+
+TEST(Lqg, TwoDofFormRealizesTheCompensator) {
+  // C1 = u/ω* and C2 = −u/y of the state space, evaluated directly (core::frequency_response).
+  for (const bool raw : {false, true}) {
+    VelocityLqgOptions o;
+    o.feedforward = 0.8;
+    o.raw_motor_velocity = raw;
+    const LqgDesign d = velocity_lqg(normalized(3.0, 0.01, 0.02, 0.05), 3.0, o);
+    const ControllerTf c = two_dof_form(d.compensator);
+    EXPECT_EQ(c.feedback.den(), c.reference.den());
+    for (const double w : {1e-3, 0.1, 0.7, 1.0, 3.0, 10.0, 100.0}) {
+      const Eigen::MatrixXcd h = core::frequency_response(d.compensator, w);
+      EXPECT_LT(std::abs(c.reference.frequency_response(w) - h(0, 0)), 1e-9 * std::abs(h(0, 0))) << w;
+      EXPECT_LT(std::abs(c.feedback.frequency_response(w) + h(0, 1)), 1e-9 * std::abs(h(0, 1))) << w;
+    }
+  }
+}
+
+TEST(Lqg, LoopOfTheTwoDofFormHasTheDesignedClosedLoopPoles) {
+  // The VelocityLoop algebra (polynomials) against the state-space closed loop of the design.
+  const NormalizedPlant plant = normalized_two_mass(3.0, 0.01);
+  const std::optional<FrictionTwoMass> m = physical_parameters_with_friction(plant);
+  ASSERT_TRUE(m.has_value());
+  EXPECT_NEAR(m->stiffness, 8.0, 1e-9);  // the frictionless normalized plant of C7.13: k = Il = r² − 1
+  EXPECT_NEAR(m->damping, 0.16, 1e-9);
+  const LqgDesign d = velocity_lqg(*m, 3.0);
+  const VelocityLoop loop(plant, two_dof_form(d.compensator), false);
+  EXPECT_TRUE(loop.stable());
+  expect_same_roots(loop.closed_loop().characteristic.roots(), d.closed_loop_poles, 1e-6, "loop poles");
+  EXPECT_NEAR(std::abs(loop.motor_tracking(1e-6)), 1.0, 1e-6);  // integral action
+  EXPECT_NEAR(std::abs(loop.load_tracking(1e-6)), 1.0, 1e-6);
+}
+
+TEST(Lqg, FeedforwardLimitMatchesScipy) {
+  // kff_max of the fixture: the largest kff with ‖ωl/ω*‖∞ = Mt (scipy brentq on the closed loop's
+  // state space); here through the 2-DoF form and VelocityLoop.
+  for (const auto& c : lqg_reference().at("velocity")) {
+    if (c.at("bm").get<double>() != 0.0 || c.at("bl").get<double>() != 0.0) continue;  // frictionless plants only
+    const double r = c.at("r"), zeta_z = c.at("zeta_z");
+    const NormalizedPlant plant = normalized_two_mass(r, zeta_z);
+    VelocityLqgOptions o;
+    o.kbw = c.at("kbw");
+    o.raw_motor_velocity = c.at("raw_motor_velocity");
+    const auto load_peak = [&](double kff) {
+      o.feedforward = kff;
+      const VelocityLoop loop(plant, two_dof_form(velocity_lqg(normalized(r, zeta_z), r, o).compensator), false);
+      return core::peak_on_grid([&](double w) { return loop.load_tracking(w); }, core::log_space(1e-3, 1e2, 4000), 1e-10)
+          .value;
+    };
+    EXPECT_NEAR(load_peak(0.0), c.at("load_tracking_peak_kff0").get<double>(), 1e-7) << "r " << r << " kbw " << o.kbw;
+    EXPECT_NEAR(load_peak(c.at("kff_max").get<double>()), c.at("mt").get<double>(), 1e-7) << "r " << r << " kbw " << o.kbw;
   }
 }
 

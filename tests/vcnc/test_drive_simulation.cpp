@@ -47,7 +47,7 @@ tuning::TuneResult tuned(const machine::PlantConfig& plant, tuning::Structure st
 
 /// The continuous closed loop of the design (no HF dynamics: the sampled loop adds only ~ts/2).
 tuning::ClosedLoopTransfer continuous_loop(const tuning::TuneResult& r) {
-  return tuning::VelocityLoop(r.plant, r.controller.normalized, false).closed_loop();
+  return tuning::VelocityLoop(r.plant, tuning::normalized_controller(r.controller), false).closed_loop();
 }
 
 template <class Get>
@@ -101,6 +101,34 @@ TEST(DriveSimulation, LoadStepFollowsTheContinuousLoopAndSettlesAtTheLoadTorque)
   EXPECT_NEAR(sim.samples.back().torque_command, s.amplitude, 1e-3 * s.amplitude);
   EXPECT_NEAR(sim.samples.back().load_velocity, 0.0, 1e-3 * std::abs(peak));
   EXPECT_TRUE(std::isfinite(sim.metrics.recovery_time));
+}
+
+TEST(DriveSimulation, LqgStepAndLoadStepFollowTheContinuousLoop) {
+  // The full-order compensator (5 states, Tustin at ts) in the sampled loop against the continuous
+  // closed loop of its 2-DoF form; its integral action balances a load torque exactly.
+  const auto plant = normalized_plant();
+  const auto r = tuned(plant, tuning::Structure::kLqg);
+  ASSERT_TRUE(r.controller.full_order.has_value());
+  DriveSimulationSettings s;
+  s.duration_s = 30.0;
+  const DriveSimulation step = simulate_drive(plant, r.controller, s);
+  EXPECT_EQ(step.controller.A.rows(), 5);
+  ASSERT_TRUE(step.full_order.has_value());
+  const auto loop = continuous_loop(r);
+  const auto load = core::step_response(*loop.load_tracking, kTs, step.samples.size());
+  EXPECT_LT(max_difference(step.samples, load, [](const DriveSample& x) { return x.load_velocity; }), 5e-3);
+  EXPECT_NEAR(step.metrics.overshoot, r.controller.predicted.overshoot, 5e-3);
+  EXPECT_NEAR(step.metrics.final_error, 0.0, 1e-4);
+
+  s.test = DriveTest::kLoadStep;
+  s.amplitude = 0.5;
+  const DriveSimulation disturbance = simulate_drive(plant, r.controller, s);
+  auto pushed = core::step_response(*loop.load_from_load_torque, kTs, disturbance.samples.size());
+  for (double& v : pushed) v *= s.amplitude;
+  const double peak = *std::max_element(pushed.begin(), pushed.end(), [](double a, double b) { return std::abs(a) < std::abs(b); });
+  EXPECT_LT(max_difference(disturbance.samples, pushed, [](const DriveSample& x) { return x.load_velocity; }),
+            5e-3 * std::abs(peak));
+  EXPECT_NEAR(disturbance.samples.back().torque_command, s.amplitude, 1e-3 * s.amplitude);
 }
 
 TEST(DriveSimulation, PositionStepFollowsTheContinuousCascade) {

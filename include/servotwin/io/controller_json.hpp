@@ -3,19 +3,25 @@
 /// The tuned controller file "servotwin.controller/1" (written by `servotwin tune`, read by the
 /// simulation and report commands):
 ///
-///     {"format": "servotwin.controller/1", "structure": "pi"|"pid"|"pi+p",
+///     {"format": "servotwin.controller/1", "structure": "pi"|"pid"|"pi+p"|"lqg",
 ///      "loop": "velocity"|"position" (position iff pi+p), "feedback": "motor",
 ///      "plant": {"source", "omega_z_hz", "motor_inertia", "r", "zeta_z", "zeta_p", "a"},
-///      "gains": {"kp", "ki", "kd", "tau", "wp", "wd", "kpp"}        (physical; kpp null unless pi+p)
-///      "normalized": {the same members, normalized},
+///      "gains": {"kp", "ki", "kd", "tau", "wp", "wd", "kpp"}        (physical; kpp null unless pi+p;
+///                                                                   null for lqg)
+///      "normalized": {the same members, normalized} (null for lqg),
 ///      "state_space": {"inputs": ["velocity_reference", "motor_velocity"], "output": "torque",
 ///                      "A", "B", "C", "D"}                            (physical, continuous)
 ///      "discrete": {"ts", "method": "tustin", "prewarp_hz" (or null), "A", "B", "C", "D"} or null,
-///      "design": {"omega_star", "omega_star_hz", "zeta_star", "r_target", "ms", "mt", "omega_star_source"},
+///      "design": {"omega_star", "omega_star_hz", "zeta_star" (null for lqg), "r_target", "ms", "mt",
+///                 "omega_star_source"},
 ///      "predicted": {every member of tuning::LoopIndices (normalized), the frequencies also in Hz
 ///                    ("bandwidth_motor_hz", "gain_crossover_hz", ...), the times also in seconds
 ///                    ("settling_time_s", ...), "closed_loop_poles": [[re, im], ...]},
-///      "robustness": {"rs", "np", "rp"},
+///      "robustness": {"rs", "np", "rp", "rp_tracking" (optional)},
+///      "position": {...} (pi+p) or null,
+///      "lqg": {"kbw", "kbw_source", "feedforward", "feedforward_source", the weights of
+///              tuning::VelocityLqgOptions, "controller_stable", "controller_poles",
+///              "compensator": {as "state_space", normalized}} (lqg) or null (may be absent),
 ///      "notes": ["..."]}
 ///
 /// Matrices are arrays of rows. Non-finite indices are written as the strings "inf" and "-inf"
@@ -27,7 +33,9 @@
 /// loop matches the structure, that the physical gains are the normalized ones de-normalized with
 /// the plant scales (tuning::to_physical, Kpp = Kpp_n·ωz; relative 1e-6), that the state spaces
 /// realize the controller of the gains (tuning::controller_state_space and
-/// tuning::discretize_controller, compared as frequency responses, relative 1e-6) and that the
+/// tuning::discretize_controller, compared as frequency responses, relative 1e-6; for lqg the
+/// compensator de-normalized, with its listed poles the eigenvalues of its A and its stability
+/// flag theirs) and that the
 /// derived members (`_hz`, `_s`) agree with the normalized ones. So a hand-edited file cannot
 /// silently mean two controllers. Unknown members are errors. Every error is a core::InputError
 /// naming the source and the field ("discrete.ts", "state_space.A[1]").

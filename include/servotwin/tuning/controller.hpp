@@ -8,6 +8,7 @@
 ///   pi    u = (wp kp + ki/s) ω* − (kp + ki/s) ωm
 ///   pid   the same plus kd s/(τ s + 1) on the measurement (wd = 0: no torque kick on steps)
 ///   pi+p  a P position loop ω* = kpp (φ* − φ) over the PI velocity loop
+///   lqg   the full-order velocity LQG compensator of C7.13 (inputs [ω*, ωm], 5 states)
 
 #include <optional>
 #include <string>
@@ -15,15 +16,19 @@
 
 #include "servotwin/core/state_space.hpp"
 #include "servotwin/tuning/loop_analysis.hpp"
+#include "servotwin/tuning/lqg.hpp"
 #include "servotwin/tuning/normalized_plant.hpp"
 #include "servotwin/tuning/pi_design.hpp"
 
 namespace servotwin::tuning {
 
 /// Controller structure offered by the tuner.
-enum class Structure { kPi, kPid, kPiP };
+enum class Structure { kPi, kPid, kPiP, kLqg };
 
-/// "pi", "pid", "pi+p".
+/// A structure whose controller is a general state space (no PID gains): lqg.
+[[nodiscard]] bool is_full_order(Structure structure) noexcept;
+
+/// "pi", "pid", "pi+p", "lqg".
 [[nodiscard]] std::string to_string(Structure structure);
 /// Inverse of to_string; std::nullopt for an unknown name.
 [[nodiscard]] std::optional<Structure> structure_from_string(const std::string& name);
@@ -37,8 +42,8 @@ struct PlantScales {
 
 /// The design choices behind the gains (normalized units; frequencies relative to ωz).
 struct DesignParameters {
-  double omega_star = 0.0;            ///< assigned pair's natural frequency ω*/ωz
-  double zeta_star = 0.0;             ///< assigned pair's damping
+  double omega_star = 0.0;            ///< assigned pair's natural frequency ω*/ωz (0: full-order, none)
+  double zeta_star = 0.0;             ///< assigned pair's damping (0: full-order, none)
   std::optional<double> r_target;     ///< PID: virtual resonance ratio r̄
   std::optional<double> ms, mt;       ///< peak limits the design respected
   std::string omega_star_source;      ///< "given", "J1 (load bandwidth)", "limited by ‖S‖ <= Ms", ...
@@ -49,6 +54,20 @@ struct RobustnessSummary {
   std::optional<double> rs;  ///< ‖W2 T‖∞ (robust stability when < 1)
   std::optional<double> np;  ///< ‖W1 S‖∞ with W1 = 1/Ms (nominal performance when < 1)
   std::optional<double> rp;  ///< sup(|W1 S| + |W2 T|) (robust performance when < 1)
+  /// C7.13's sufficient robust tracking test of the 2-DoF loop, sup |W1 F T|(1 + |W2|)/(1 − |W2 T|)
+  /// with W1 = 1/Mt and F T = ωm/ω* (< 1: the motor tracking peak stays below Mt for every plant
+  /// in the uncertainty set; +inf where |W2 T| >= 1).
+  std::optional<double> rp_tracking;
+};
+
+/// A full-order (LQG) design, normalized units (C7.13).
+struct FullOrderSummary {
+  VelocityLqgOptions weights;         ///< the weights used, with the chosen kbw and kff
+  std::string kbw_source;             ///< "given", or what limited the automatic kbw
+  std::string feedforward_source;     ///< "given", "none", or what limited the automatic kff
+  core::StateSpace compensator;       ///< normalized: inputs [ω*, ωm], output u (time by ωz, torque by Im ωz)
+  std::vector<std::complex<double>> controller_poles;  ///< normalized
+  bool controller_stable = false;     ///< every compensator pole stable (the integrator excepted)
 };
 
 /// The P position loop of a pi+p design (C7.10), normalized units (gains in units of ωz).
@@ -64,8 +83,9 @@ struct PositionSummary {
 /// A tuned cascade controller.
 struct Controller {
   Structure structure = Structure::kPi;
-  PidGains normalized;                  ///< velocity-loop gains, normalized (kd = tau = 0 for PI)
+  PidGains normalized;                  ///< velocity-loop gains, normalized (kd = tau = 0 for PI; all 0 for lqg)
   PidGains physical;                    ///< the same in the model's units (to_physical)
+  std::optional<FullOrderSummary> full_order;  ///< lqg only: the compensator (the gains are then unused)
   std::optional<double> kpp_normalized;  ///< pi+p: position gain, normalized
   std::optional<double> kpp_physical;    ///< pi+p: position gain [1/s]
   PlantScales plant;
@@ -82,10 +102,25 @@ struct Controller {
 /// normalized, as the gains): a PI has the integrator state, a PID also the derivative filter's.
 [[nodiscard]] core::StateSpace controller_state_space(const PidGains& gains);
 
+/// A normalized velocity-loop controller (inputs [ω*, ωm], output u) in the model's units: time
+/// scaled by 1/ωz, torque by Im ωz (velocities are not scaled): A ωz, B ωz, C Im ωz, D Im ωz.
+[[nodiscard]] core::StateSpace to_physical(const core::StateSpace& normalized, const PlantScales& plant);
+
+/// The controller in the model's units: the PID's realization, or the full-order compensator
+/// de-normalized. Throws std::invalid_argument for a full-order structure without its compensator.
+[[nodiscard]] core::StateSpace controller_state_space(const Controller& controller);
+
+/// The normalized velocity controller as the 2-DoF transfer functions a VelocityLoop takes: the
+/// PID's, or the full-order compensator's two_dof_form().
+[[nodiscard]] ControllerTf normalized_controller(const Controller& controller);
+
 /// Tustin discretization of controller_state_space at the drive period ts [s] (physical gains),
 /// prewarped at `prewarp_rad_s` when given (it must lie below π/ts). Throws core::InputError
 /// (field "ts") when ts is not finite and > 0 or the prewarp frequency lies at or above Nyquist.
 [[nodiscard]] core::DiscreteStateSpace discretize_controller(const PidGains& physical, double ts,
+                                                             std::optional<double> prewarp_rad_s = std::nullopt);
+/// The same for any controller (controller_state_space(controller)).
+[[nodiscard]] core::DiscreteStateSpace discretize_controller(const Controller& controller, double ts,
                                                              std::optional<double> prewarp_rad_s = std::nullopt);
 
 }  // namespace servotwin::tuning

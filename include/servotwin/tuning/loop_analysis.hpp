@@ -48,7 +48,7 @@ struct AnalysisOptions {
   /// analyse() adds 1 (ωz), r and the higher modes' frequencies.
   std::vector<double> extra_frequencies;
   /// Where hf_controller_gain is evaluated. <= 0: 10·r in the plant overload of analyse(); in the
-  /// VelocityLoop overload (which does not know r) the limit |C(j∞)| = |kp + kd/τ| instead.
+  /// VelocityLoop overload (which does not know r) the limit |C(j∞)| (= |kp + kd/τ| for a PID) instead.
   double hf_gain_omega = 0.0;
   double horizon_time_constants = 15.0;  ///< simulation horizon in time constants of the slowest pole
   std::size_t max_samples = 20000;      ///< cap on the simulation samples (>= 100)
@@ -108,6 +108,9 @@ struct LoopIndices {
 /// with 1, r and the higher modes' frequencies added to the grid and hf_gain_omega defaulting to
 /// 10·r.
 [[nodiscard]] LoopIndices analyse(const NormalizedPlant& plant, const PidGains& gains,
+                                  const AnalysisOptions& options = {});
+/// The same for any 2-DoF controller (an LQG's two_dof_form()).
+[[nodiscard]] LoopIndices analyse(const NormalizedPlant& plant, const ControllerTf& controller,
                                   const AnalysisOptions& options = {});
 
 /// J1/J2 search settings (C7.8).

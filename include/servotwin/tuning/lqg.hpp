@@ -32,6 +32,7 @@
 
 #include "servotwin/core/state_space.hpp"
 #include "servotwin/tuning/normalized_plant.hpp"
+#include "servotwin/tuning/velocity_loop.hpp"
 
 namespace servotwin::tuning {
 
@@ -78,5 +79,16 @@ struct LqgDesign {
 
 /// The position LQG of C7.13 (field names as above).
 [[nodiscard]] LqgDesign position_lqg(const FrictionTwoMass& plant, double r, const PositionLqgOptions& options = {});
+
+/// The compensator's stability rule of LqgDesign::controller_stable: every pole in the open left
+/// half-plane except one integrator pole at 0 (within 1e-9 of the largest pole's modulus).
+[[nodiscard]] bool stable_except_integrator(const std::vector<std::complex<double>>& poles);
+
+/// The 2-DoF form of a compensator with inputs [reference, y] and output u (C7.13 robust
+/// analysis): u = C1 reference − C2 y with C1 = Cc(sI − Ac)⁻¹B1 + D1, C2 = −(Cc(sI − Ac)⁻¹B2 + D2)
+/// over the one denominator det(sI − Ac) (no cancellation; the prefilter is F = C1/C2). A
+/// VelocityLoop built from it gives every loop function of the LQG loop. std::invalid_argument
+/// unless the compensator has 2 inputs and 1 output.
+[[nodiscard]] ControllerTf two_dof_form(const core::StateSpace& compensator);
 
 }  // namespace servotwin::tuning

@@ -10,6 +10,11 @@
 /// tracking peak ‖ωl/ω*‖∞ <= Mt (‖ωm/ω*‖∞ when there is no load side) — then place the pair (PI)
 /// or the virtual-inertia PID (C7.5), add the P position loop (C7.10) for pi+p, and analyse the
 /// result (indices, margins, time responses).
+///
+/// lqg: the velocity LQG of C7.13 on the first mode's two-mass realization (with its viscous
+/// friction); kbw scanned from slow (1e3) to fast (1e-4) on a log grid and the boundary of the
+/// spec refined by bisection, then the feedforward kff raised (doubling, then bisection) while the
+/// spec holds; analysed through its 2-DoF form with the HF dynamics and higher modes included.
 
 #include <optional>
 #include <string>
@@ -19,6 +24,7 @@
 #include "servotwin/fit/plant_model.hpp"
 #include "servotwin/tuning/controller.hpp"
 #include "servotwin/tuning/loop_analysis.hpp"
+#include "servotwin/tuning/lqg.hpp"
 #include "servotwin/tuning/normalized_plant.hpp"
 #include "servotwin/tuning/pi_design.hpp"
 
@@ -41,6 +47,14 @@ struct TuneOptions {
   std::optional<double> ts;             ///< drive sample period [s]: discretize the controller
   double setpoint_weight = 1.0;         ///< wp of the 2-DoF PI/PID
   std::size_t scan_points = 24;         ///< automatic ω*: candidates on the admissible range
+  /// lqg: the weights of C7.13 (their kbw and feedforward are ignored: see the next two).
+  VelocityLqgOptions lqg;
+  /// lqg: the bandwidth knob; std::nullopt: the smallest kbw (fastest loop) that meets the same
+  /// spec as automatic ω* (stable with the HF dynamics, ‖S‖∞ <= Ms, tracking peak <= Mt and, with
+  /// W2, robust stability and C7.13's robust tracking test).
+  std::optional<double> kbw;
+  /// lqg: kff; std::nullopt: the largest that keeps the spec above (C7.13: the tracking peak <= Mt).
+  std::optional<double> feedforward;
 };
 
 /// Everything the tuner found, for the CLI summary, the controller file and the report.
@@ -49,7 +63,8 @@ struct TuneResult {
   ResonanceRatioAdvice advice;      ///< C7.4 verdict for r
   AdmissibleRange range;            ///< admissible ω* of the assigned pair
   Controller controller;            ///< the tuned controller (physical and normalized)
-  /// Automatic ω*: the scanned candidates (ω*, load bandwidth, ‖S‖∞, tracking peak, feasible).
+  /// Automatic ω* (lqg: kbw, from slow to fast): the scanned candidates (the parameter in
+  /// omega_star, load bandwidth, ‖S‖∞, tracking peak, feasible).
   struct Candidate {
     double omega_star = 0.0, bandwidth = 0.0, peak_s = 0.0, peak_tracking = 0.0;
     bool stable = false, feasible = false;

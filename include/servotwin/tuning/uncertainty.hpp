@@ -109,6 +109,19 @@ struct RobustnessResult {
 [[nodiscard]] RobustnessResult robustness(const VelocityLoop& loop, const core::TransferFunction& w2, double ms,
                                           const RobustnessOptions& options = {});
 
+/// C7.13's sufficient robust performance test of a 2-DoF loop's tracking (the LQG compensators):
+/// with the plant Pm(1 + Δ W2), |Δ| <= 1, the motor tracking ωm/ω* = F T becomes F T (1 + Δ W2)/(1 + Δ W2 T),
+/// so sup_ω |F T| (1 + |W2|)/(1 − |W2 T|) / mt < 1 guarantees ‖ωm/ω*‖∞ < mt for every plant of the set.
+struct RobustTracking {
+  double value = 0.0;  ///< the sup above (+inf when ‖W2 T‖∞ >= 1 or the loop is unstable)
+  double omega = 0.0;  ///< where attained (normalized)
+  [[nodiscard]] bool ok() const noexcept { return value < 1.0; }
+};
+
+/// The test above on robustness()'s grid. InputError naming "mt" (unless finite and >= 1) or "w2".
+[[nodiscard]] RobustTracking robust_tracking(const VelocityLoop& loop, const core::TransferFunction& w2, double mt,
+                                             const RobustnessOptions& options = {});
+
 /// Which test the ω* search applies.
 enum class RobustTest {
   kRobustStability,   ///< RS only

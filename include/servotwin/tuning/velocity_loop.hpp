@@ -27,7 +27,8 @@
 
 namespace servotwin::tuning {
 
-/// The 2-DoF PID as two transfer functions: u = reference·ω* − feedback·y.
+/// A 2-DoF controller as two transfer functions over one denominator: u = reference·ω* − feedback·y.
+/// The PID below, or any linear compensator with inputs [ω*, y] (an LQG's, via two_dof_form()).
 struct ControllerTf {
   core::TransferFunction feedback;   ///< C(s)
   core::TransferFunction reference;  ///< R(s) (same denominator as C)
@@ -81,8 +82,14 @@ class VelocityLoop {
   /// NormalizedPlant from normalize() always has r > 1.05).
   VelocityLoop(const NormalizedPlant& plant, const PidGains& gains, bool with_hf = true,
                bool with_higher_modes = true, int pade_order = 6);
+  /// The same loop around any proper 2-DoF controller (normalized units); `controller.reference`
+  /// must have the denominator of `controller.feedback` (std::invalid_argument otherwise).
+  VelocityLoop(const NormalizedPlant& plant, ControllerTf controller, bool with_hf = true,
+               bool with_higher_modes = true, int pade_order = 6);
 
-  [[nodiscard]] const PidGains& gains() const noexcept { return gains_; }
+  [[nodiscard]] const ControllerTf& controller_tf() const noexcept { return controller_; }
+  /// |C(j∞)|: the controller's high-frequency gain (the ratio of leading coefficients).
+  [[nodiscard]] double controller_hf_limit() const noexcept;
   [[nodiscard]] bool has_load() const noexcept { return has_load_; }
 
   /// Frequency functions at s = jω (normalized ω >= 0), delay exact.
@@ -124,7 +131,6 @@ class VelocityLoop {
   /// Δ alone (what stable() needs), without the closed-loop numerators.
   [[nodiscard]] core::Polynomial characteristic(const core::Polynomial& delay_num, const core::Polynomial& delay_den) const;
 
-  PidGains gains_;
   ControllerTf controller_;
   core::Polynomial plant_num_, plant_den_;        // Pm = plant_num/plant_den (den monic)
   core::Polynomial act_num_{1.0}, act_den_{1.0};  // rational actuator part

@@ -115,7 +115,8 @@ struct DriveSimulation {
   double amplitude = 0.0;
   std::optional<double> torque_limit;  ///< as simulated
   double settling_band = 0.0;          ///< as simulated
-  tuning::PidGains gains;              ///< the physical velocity-loop gains
+  tuning::PidGains gains;              ///< the physical velocity-loop gains (cascade structures)
+  std::optional<tuning::FullOrderSummary> full_order;  ///< lqg: the compensator's design (normalized)
   std::optional<double> kpp;           ///< pi+p: the physical position gain [1/s]
   bool load_side = false;           ///< the plant is a mass chain with a load (metrics on the load)
   std::vector<DriveSample> samples;         ///< the plant with its nonlinearities
