@@ -1,7 +1,6 @@
 // `servotwin tune`: a cascade PI/PID (and P position loop) for a flexible drive from its fitted
 // plant model, checked against the known HF dynamics, written as controller.json.
 #include <chrono>
-#include <fmt/ranges.h>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -13,12 +12,13 @@
 #include "report_output.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/controller_json.hpp"
-#include "servotwin/io/frf_csv.hpp"
 #include "servotwin/report/tuning_report.hpp"
 #include "servotwin/tuning/tune.hpp"
 #include "servotwin/tuning/uncertainty.hpp"
 #include "servotwin/vcnc/drive_simulation.hpp"
+#include "tune_compare.hpp"
 #include "tune_input.hpp"
+#include "tune_options.hpp"
 
 namespace servotwin::cli {
 
@@ -35,10 +35,7 @@ struct TuneArgs {
   double target_r = 2.0;
   std::optional<double> tau;
   bool allow_negative_kd = false;
-  double ms = 1.5, mt = 1.5;
-  std::string w2_num, w2_den, w2_from_frf;
-  int w2_order = 1;
-  std::optional<double> current_lag, filter, delay, ts;
+  TuneSpecArgs spec;
   double setpoint_weight = 1.0;
   std::string out;
   std::string report;
@@ -54,25 +51,6 @@ std::optional<double> parse_auto(const std::string& text, const char* flag, bool
   return v;
 }
 
-/// W2 as the tightest stable envelope of the fitted model's relative error on the measured points.
-core::TransferFunction weight_from_residuals(const TuneArgs& a, const TunePlant& plant) {
-  if (!plant.fitted) {
-    throw core::InputError(core::at_field("--w2-from-frf"),
-                           "needs a fitted plant model (servotwin.plant-model/1) to compare the measurement with");
-  }
-  const core::FrequencyResponse measured = io::read_frf_file(a.w2_from_frf);
-  try {
-    const tuning::UncertaintyEnvelope e = tuning::uncertainty_weight_from_residuals(plant.model, measured, a.w2_order);
-    const auto& n = e.w2.num().coefficients();
-    const auto& d = e.w2.den().coefficients();
-    fmt::print("uncertainty weight from {}: W2(s) = ({}) / ({}) (s in rad/s), log-area {:.3g}\n", a.w2_from_frf,
-               fmt::join(n.begin(), n.end(), ", "), fmt::join(d.begin(), d.end(), ", "), e.log_area);
-    return e.w2;
-  } catch (const core::InputError& e) {
-    throw core::InputError({a.w2_from_frf, 0, 0, e.where().field}, e.reason());
-  }
-}
-
 tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
   tuning::TuneOptions o;
   o.structure = *tuning::structure_from_string(a.structure);
@@ -84,26 +62,8 @@ tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
   o.target_r = a.target_r;
   o.tau = a.tau;
   o.allow_negative_kd = a.allow_negative_kd;
-  o.ms = a.ms;
-  o.mt = a.mt;
   o.setpoint_weight = a.setpoint_weight;
-  if (a.w2_num.empty() != a.w2_den.empty()) {
-    throw core::InputError(core::at_field(a.w2_num.empty() ? "--w2-num" : "--w2-den"), "give both --w2-num and --w2-den");
-  }
-  if (!a.w2_num.empty() && !a.w2_from_frf.empty()) {
-    throw core::InputError(core::at_field("--w2-from-frf"), "give either --w2-num/--w2-den or --w2-from-frf, not both");
-  }
-  if (!a.w2_num.empty()) {
-    o.w2 = core::TransferFunction(parse_coefficients(a.w2_num, "--w2-num"), parse_coefficients(a.w2_den, "--w2-den"));
-  }
-  if (!a.w2_from_frf.empty()) o.w2 = weight_from_residuals(a, plant);
-  o.hf = plant.hf;
-  // Options override what a plant description says.
-  if (a.current_lag) o.hf.current_lag_s = *a.current_lag;
-  if (a.filter) o.hf.feedback_filter_s = *a.filter;
-  if (a.delay) o.hf.delay_s = *a.delay;
-  o.ts = a.ts ? a.ts : plant.ts;
-  if (o.ts) check_sample_period(*o.ts, "--ts");
+  apply_spec(a.spec, plant, o);
   return o;
 }
 
@@ -256,8 +216,7 @@ void register_tune(CLI::App& app, Action& selected) {
       "plant model");
   cmd->add_option("plant", a->plant,
                   "Plant: a fitted model (servotwin.plant-model/1 from `servotwin fit`), a plant description "
-                  "(servotwin.plant/1) or a flexible preset name")
-      ->required();
+                  "(servotwin.plant/1) or a flexible preset name");
   cmd->add_option("--structure", a->structure,
                   "pi, pid (virtual inertia, C7.5), pi+p (P position loop over the PI) or lqg (full-order velocity "
                   "LQG, C7.13)")
@@ -269,7 +228,7 @@ void register_tune(CLI::App& app, Action& selected) {
                   "the largest load bandwidth within --ms/--mt")
       ->capture_default_str();
   cmd->add_option("--kbw", a->kbw,
-                  "LQG: bandwidth knob of the normalized weights (larger = slower), or auto: the fastest within "
+                  "LQG: bandwidth knob of the normalized weights (larger = slower), or auto: the largest load bandwidth within "
                   "--ms/--mt (and robust tracking with W2)")
       ->capture_default_str();
   cmd->add_option("--kff", a->kff,
@@ -282,20 +241,7 @@ void register_tune(CLI::App& app, Action& selected) {
       ->capture_default_str();
   cmd->add_option("--tau", a->tau, "PID: derivative filter time constant [s] (default: 1/max(r, 5 omega*) in omega_z units)");
   cmd->add_flag("--allow-negative-kd", a->allow_negative_kd, "PID: accept a negative Kd (r < r-bar: acceleration feedback)");
-  cmd->add_option("--ms", a->ms, "Limit on the sensitivity peak ||S||")->capture_default_str();
-  cmd->add_option("--mt", a->mt, "Limit on the tracking peak ||wl/w*|| (motor side without a load side)")
-      ->capture_default_str();
-  cmd->add_option("--w2-num", a->w2_num, "Uncertainty weight W2(s) numerator, descending powers of s [rad/s], e.g. \"2.6,0\"");
-  cmd->add_option("--w2-den", a->w2_den, "Uncertainty weight W2(s) denominator, e.g. \"1,15\"");
-  cmd->add_option("--w2-from-frf", a->w2_from_frf,
-                  "Uncertainty weight fitted above the model's relative error on this measured response (servotwin.frf/1); "
-                  "needs a fitted plant model")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--w2-order", a->w2_order, "Order of the fitted weight (1 or 2)")->check(CLI::IsMember({1, 2}))->capture_default_str();
-  cmd->add_option("--current-lag", a->current_lag, "Current-loop time constant [s] (evaluated, not designed for)");
-  cmd->add_option("--filter", a->filter, "Velocity-measurement filter time constant [s]");
-  cmd->add_option("--delay", a->delay, "Loop delay [s] (computation, communication, half a sample of hold)");
-  cmd->add_option("--ts", a->ts, "Drive sample period [s]: also write the Tustin-discretized controller");
+  add_spec_options(*cmd, a->spec);
   cmd->add_option("--setpoint-weight", a->setpoint_weight, "Proportional setpoint weight wp in [0, 1] (2-DoF)")
       ->capture_default_str();
   cmd->add_option("-o,--out", a->out, "Write the controller (servotwin.controller/1 JSON; - for stdout)");
@@ -307,7 +253,12 @@ void register_tune(CLI::App& app, Action& selected) {
                "  servotwin tune plant_model.json --w2-from-frf frf.csv\n"
                "  servotwin tune table-5.1 --structure lqg --ts 0.000125 -o lqg.json --report lqg.html\n"
                "  servotwin tune plant_model.json --delay 0.0005 --w2-num 2.6,0 --w2-den 1,15 --ms 1.6\n");
-  cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });
+  add_tune_compare(*cmd, selected);
+  cmd->callback([a, cmd, &selected] {
+    if (cmd->got_subcommand("compare")) return;  // its own callback chose the action
+    if (a->plant.empty()) throw CLI::RequiredError("plant");
+    selected = [a](const GlobalOptions& g) { return run(*a, g); };
+  });
 }
 
 }  // namespace servotwin::cli

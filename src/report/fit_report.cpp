@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bode.hpp"
+#include "chart_helpers.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/transfer_function.hpp"
 #include "number_format.hpp"
@@ -188,13 +189,7 @@ Section response_section(const core::FrequencyResponse& measured, const fit::Pla
   }
 
   const auto chart = [](std::string title, std::string y_label, Scale y_scale) {
-    Chart c;
-    c.title = std::move(title);
-    c.x_label = "frequency [Hz]";
-    c.y_label = std::move(y_label);
-    c.x_scale = Scale::Log;
-    c.y_scale = y_scale;
-    return c;
+    return detail::frequency_chart(std::move(title), std::move(y_label), y_scale);
   };
   Chart mag = chart("Magnitude", "magnitude [dB]", Scale::Linear);
   mag.series.push_back({"measured", f_meas, magnitude_db(p_meas)});

@@ -12,6 +12,7 @@
 
 #include "bode.hpp"
 #include "number_format.hpp"
+#include "chart_helpers.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/state_space.hpp"
 #include "servotwin/report/drive_report.hpp"
@@ -24,7 +25,13 @@ namespace servotwin::report {
 namespace {
 
 using Complex = std::complex<double>;
+using detail::db_of;
+using detail::flat;
+using detail::frequency_chart;
 using detail::magnitude_db;
+using detail::scaled;
+using detail::time_grid;
+using detail::TimeGrid;
 using detail::unwrapped_phase_deg;
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
@@ -101,32 +108,10 @@ std::vector<double> frequency_grid(const tuning::TuneResult& r, std::size_t poin
   return with_exact_points(core::log_space(bottom, kFactorAbove * top, points), exact);
 }
 
-Chart frequency_chart(std::string title, std::string y_label, Scale y_scale = Scale::Linear) {
-  Chart c;
-  c.title = std::move(title);
-  c.x_label = "frequency [Hz]";
-  c.y_label = std::move(y_label);
-  c.x_scale = Scale::Log;
-  c.y_scale = y_scale;
-  return c;
-}
-
-/// A horizontal line over the chart's frequency span (two points; the chart spans the gaps).
-Series flat(std::string label, const std::vector<double>& x, double y) {
-  return {std::move(label), {x.front(), x.back()}, {y, y}};
-}
-
 /// A vertical marker at x from y0 to y1: two points 1e-6 apart in x (a line chart aligns its
 /// series on x, so two points at one x would merge).
 Series vertical(std::string label, double x, double y0, double y1) {
   return {std::move(label), {x * (1.0 - 1e-6), x * (1.0 + 1e-6)}, {y0, y1}};
-}
-
-std::vector<double> db_of(const std::vector<Complex>& g, double scale = 1.0) {
-  std::vector<double> out = magnitude_db(g);
-  const double offset = 20.0 * std::log10(scale);
-  for (double& v : out) v += offset;
-  return out;
 }
 
 double db(double v) { return 20.0 * std::log10(v); }
@@ -639,30 +624,6 @@ Section position_section(const Context& c, const tuning::VelocityLoop& base,
 
 // ---------------------------------------------------------------- 5. time responses
 
-struct TimeGrid {
-  double dt = 0.0;  ///< normalized
-  std::size_t samples = 0;
-};
-
-/// The analysis' horizon (15 time constants of the slowest closed-loop pole) at its step, or at a
-/// coarser step when that would need more than `max_samples` (the samples stay exact: a step is
-/// held constant between them).
-TimeGrid time_grid(double horizon, double sample_time, std::size_t max_samples) {
-  TimeGrid g;
-  g.dt = sample_time;
-  g.samples = static_cast<std::size_t>(std::ceil(horizon / sample_time)) + 1;
-  if (g.samples > max_samples) {
-    g.samples = max_samples;
-    g.dt = horizon / static_cast<double>(max_samples - 1);
-  }
-  return g;
-}
-
-std::vector<double> scaled(std::vector<double> v, double factor) {
-  for (double& x : v) x *= factor;
-  return v;
-}
-
 Section time_section(const Context& c, const tuning::VelocityLoop& loop,
                      const tuning::VelocityLoop& position_base_loop) {
   Section s;
@@ -736,14 +697,7 @@ Section time_section(const Context& c, const tuning::VelocityLoop& loop,
   return s;
 }
 
-void check_options(const TuningReportOptions& o) {
-  if (o.frequency_points < kMinPoints)
-    throw core::InputError(core::at_field("frequency_points"),
-                           fmt::format("expected at least {} points, got {}", kMinPoints, o.frequency_points));
-  if (o.time_points < kMinPoints)
-    throw core::InputError(core::at_field("time_points"),
-                           fmt::format("expected at least {} samples, got {}", kMinPoints, o.time_points));
-}
+void check_options(const TuningReportOptions& o) { detail::check_point_counts(o.frequency_points, o.time_points, kMinPoints); }
 
 }  // namespace
 

@@ -317,39 +317,48 @@ std::vector<double> kbw_candidates() {
   return k;
 }
 
-/// The smallest kbw (fastest loop) meeting the spec, from the scan and a bisection at its boundary.
-double automatic_kbw(const LqgDesigner& lqg, const SpecCheck& check, TuneResult& result) {
-  const auto evaluate = [&](double kbw) { return check(kbw, lqg.loop(lqg.design(kbw, 0.0))); };
-  for (double kbw : kbw_candidates()) result.scan.push_back(evaluate(kbw));
-  const TuneResult::Candidate chosen = choose(result.scan, evaluate);
-  if (!chosen.feasible) no_feasible_omega(result.scan, check.options);
-  return chosen.omega_star;
-}
+/// The automatic feedforward at one kbw and what limited it.
+struct Feedforward {
+  double kff = 0.0;
+  std::string source;
+};
 
 /// The largest kff in [0, kFeedforwardCap] keeping the spec (C7.13: the tracking peak <= Mt):
-/// doubling to the first failure, then bisection. 0 when the loop misses the spec without it.
-double automatic_feedforward(const LqgDesigner& lqg, const SpecCheck& check, double kbw, std::string& source) {
+/// doubling to the first failure, then `bisections` halvings. 0 when the loop misses the spec
+/// without it.
+Feedforward automatic_feedforward(const LqgDesigner& lqg, const SpecCheck& check, double kbw, int bisections) {
   const auto feasible = [&](double kff) { return check(kbw, lqg.loop(lqg.design(kbw, kff))).feasible; };
-  if (!feasible(0.0)) {
-    source = "none: the loop misses the spec already without feedforward";
-    return 0.0;
-  }
+  if (!feasible(0.0)) return {0.0, "none: the loop misses the spec already without feedforward"};
   double lo = 0.0, hi = 0.125;
   while (hi < kFeedforwardCap && feasible(hi)) {
     lo = hi;
     hi *= 2.0;
   }
-  if (hi >= kFeedforwardCap && feasible(hi)) {
-    source = fmt::format("capped at {:g}: the spec never binds", kFeedforwardCap);
-    return hi;
-  }
-  for (int it = 0; it < kFeedforwardBisections; ++it) {
+  if (hi >= kFeedforwardCap && feasible(hi)) return {hi, fmt::format("capped at {:g}: the spec never binds", kFeedforwardCap)};
+  for (int it = 0; it < bisections; ++it) {
     const double mid = 0.5 * (lo + hi);
     (feasible(mid) ? lo : hi) = mid;
   }
-  source = check.w2 ? "largest keeping the tracking peak <= Mt and robust tracking"
-                    : "largest keeping the tracking peak <= Mt";
-  return lo;
+  return {lo, check.w2 ? "largest keeping the tracking peak <= Mt and robust tracking"
+                       : "largest keeping the tracking peak <= Mt"};
+}
+
+/// The kbw giving the largest load bandwidth within the spec: each candidate is evaluated with its
+/// feedforward (the given one, or the automatic one to 2^-12 of its bracket: enough to rank), since
+/// the feedforward, not only the feedback, sets the tracking bandwidth; feasibility in kbw need not
+/// be monotone (‖S‖∞ hovers near Ms over decades of kbw on high-r plants), so the whole scan is
+/// ranked, then the boundary next to the best refined by bisection.
+double automatic_kbw(const LqgDesigner& lqg, const SpecCheck& check, const std::optional<double>& given_kff,
+                     TuneResult& result) {
+  constexpr int kRankingBisections = 12;
+  const auto evaluate = [&](double kbw) {
+    const double kff = given_kff ? *given_kff : automatic_feedforward(lqg, check, kbw, kRankingBisections).kff;
+    return check(kbw, lqg.loop(lqg.design(kbw, kff)));
+  };
+  for (double kbw : kbw_candidates()) result.scan.push_back(evaluate(kbw));
+  const TuneResult::Candidate chosen = choose(result.scan, evaluate);
+  if (!chosen.feasible) no_feasible_omega(result.scan, check.options);
+  return chosen.omega_star;
 }
 
 std::string pole_list(const std::vector<std::complex<double>>& poles) {
@@ -373,15 +382,17 @@ void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& c
     f.weights.kbw = *options.kbw;
     f.kbw_source = "given";
   } else {
-    f.weights.kbw = automatic_kbw(lqg, check, result);
-    f.kbw_source = options.w2 ? "smallest (fastest) with ||S|| <= Ms, tracking peak <= Mt and robust tracking"
-                              : "smallest (fastest) with ||S|| <= Ms and tracking peak <= Mt";
+    f.weights.kbw = automatic_kbw(lqg, check, options.feedforward, result);
+    f.kbw_source = options.w2 ? "largest load bandwidth with ||S|| <= Ms, tracking peak <= Mt and robust tracking"
+                              : "largest load bandwidth with ||S|| <= Ms and tracking peak <= Mt";
   }
   if (options.feedforward) {
     f.weights.feedforward = *options.feedforward;
     f.feedforward_source = "given";
   } else {
-    f.weights.feedforward = automatic_feedforward(lqg, check, f.weights.kbw, f.feedforward_source);
+    const Feedforward ff = automatic_feedforward(lqg, check, f.weights.kbw, kFeedforwardBisections);
+    f.weights.feedforward = ff.kff;
+    f.feedforward_source = ff.source;
   }
   const LqgDesign d = lqg.design(f.weights.kbw, f.weights.feedforward);
   f.compensator = d.compensator;

@@ -88,6 +88,33 @@ TEST_F(Cli, TuneExplainsWhatItCannotDo) {
   EXPECT_NE(r.err.find("--kff"), std::string::npos) << r.err;
 }
 
+TEST_F(Cli, TuneCompareTunesEveryStructureToOneSpec) {
+  // C7.15 on table-5.1 (r = 3): a table with PI as the reference (x1.00) and PID and LQG faster.
+  const Result r = run("tune compare table-5.1 --report compare.html");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("spec: largest load bandwidth"), std::string::npos) << r.out;
+  for (const char* row : {"\npi ", "\npid ", "\nlqg "}) EXPECT_NE(r.out.find(row), std::string::npos) << row << r.out;
+  EXPECT_NE(r.out.find("x1.00"), std::string::npos) << r.out;
+  EXPECT_NE(slurp(path("compare.html")).find("Structures tuned to the same spec"), std::string::npos);
+  // The same numbers as the single-structure command.
+  const Result lqg = run("tune table-5.1 --structure lqg");
+  ASSERT_EQ(lqg.status, 0) << lqg.err;
+  const auto kbw_of = [](const std::string& text) {
+    std::size_t at = text.find("kbw") + 3;
+    while (at < text.size() && (text[at] == ' ' || text[at] == '=')) ++at;
+    return std::stod(text.substr(at));
+  };
+  EXPECT_EQ(kbw_of(r.out.substr(r.out.find("\nlqg "))), kbw_of(lqg.out)) << r.out << lqg.out;
+  Result bad = run("tune compare table-5.1 --structures pi,pi+p");
+  EXPECT_EQ(bad.status, 3);
+  EXPECT_NE(bad.err.find("--structures"), std::string::npos) << bad.err;
+  bad = run("tune compare");
+  EXPECT_EQ(bad.status, 2);
+  bad = run("tune");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("plant"), std::string::npos) << bad.err;
+}
+
 TEST_F(Cli, TuneWithAnUncertaintyWeightFromTheFitResiduals) {
   write("frf.csv", e10_csv(40));
   ASSERT_EQ(run("fit frf.csv --model two-mass -o pm.json").status, 0);

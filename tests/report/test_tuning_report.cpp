@@ -376,6 +376,69 @@ TEST(TuningReport, WithoutALoadSideDrawsOnlyTheMotorSide) {
   expect_html_has_every_chart(doc, 1'000'000);
 }
 
+TEST(TuningReport, LqgShowsItsDesignAndTheCompensatorsStability) {
+  tuning::TuneOptions o;
+  o.structure = tuning::Structure::kLqg;
+  const tuning::TuneResult r = tuning::tune(table_5_1_model(), o);
+  const Document doc = tuning_report(r, {"table-5.1", std::nullopt});
+  expect_finite(doc, r);
+  expect_html_has_every_chart(doc, 3'000'000);
+  EXPECT_NE(doc.subtitle.find("kbw = "), std::string::npos) << doc.subtitle;
+  const Section& design = must(find_section(doc, "Design"));
+  const Table& lqg = must(find_table(design, "LQG design (C7.13"));
+  EXPECT_EQ(cell(lqg, "kbw"), num(r.controller.full_order->weights.kbw, 5));
+  EXPECT_EQ(cell(lqg, "compensator states"), "5");
+  EXPECT_EQ(cell(lqg, "compensator"), r.controller.full_order->controller_stable ? "stable" : "UNSTABLE");
+  EXPECT_NE(find_table(design, "Automatic kbw scan"), nullptr);
+  // The step responses are those of the LQG loop: they settle at 1 (integral action).
+  const Series& load = must(find_series(must(find_chart(must(find_section(doc, "Time responses (linear)")),
+                                                        "Velocity setpoint step")),
+                                        "load velocity ωl"));
+  EXPECT_NEAR(load.y.back(), 1.0, 1e-3);
+}
+
+TEST(ComparisonReport, OneTableAndEveryStructureInEachChart) {
+  // table-5.1 (r = 3): PI, PID and LQG all design; the table's bandwidths are the designs' own in
+  // Hz (× ωz/2π, ωz = 1 rad/s here) and the ratios to the PI; each chart overlays the three.
+  const std::vector<tuning::StructureComparison> c = tuning::compare_structures(table_5_1_model(), {});
+  const Document doc = comparison_report(c, {"table-5.1"});
+  for (const Section& s : doc.sections)
+    for (const Chart& chart : s.charts)
+      for (const Series& series : chart.series)
+        for (double y : series.y) EXPECT_TRUE(std::isfinite(y)) << chart.title << " / " << series.label;
+  expect_html_has_every_chart(doc, 3'000'000);
+  const Table& t = must(find_table(must(find_section(doc, "Comparison")), "Structures tuned to the same spec"));
+  ASSERT_EQ(t.rows.size(), 3U);
+  const double hz = 1.0 / kTwoPi;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const tuning::LoopIndices& i = c[k].result->controller.predicted;
+    EXPECT_EQ(t.rows[k][2], num(i.bandwidth_load * hz, 4));
+    EXPECT_EQ(t.rows[k][3], "×" + num(i.bandwidth_load / c[0].result->controller.predicted.bandwidth_load, 3));
+  }
+  const Chart& tracking =
+      must(find_chart(must(find_section(doc, "Loop shapes")), "Tracking: load velocity per velocity reference |ωl/ω*|"));
+  EXPECT_NE(find_series(tracking, "pi"), nullptr);
+  EXPECT_NE(find_series(tracking, "pid"), nullptr);
+  EXPECT_NE(find_series(tracking, "lqg"), nullptr);
+  const Chart& steps = must(find_chart(must(find_section(doc, "Time responses (linear)")),
+                                       "Load velocity after a unit velocity step"));
+  for (const Series& series : steps.series) EXPECT_NEAR(series.y.back(), 1.0, 1e-3) << series.label;
+  const Chart& load_steps = must(find_chart(must(find_section(doc, "Time responses (linear)")),
+                                            "Load velocity after a unit load-torque step"));
+  for (const Series& series : load_steps.series) EXPECT_NEAR(series.y.back(), 0.0, 1e-3) << series.label;
+}
+
+TEST(ComparisonReport, AFailedStructureIsARowWithItsReason) {
+  const std::vector<tuning::StructureComparison> c =
+      tuning::compare_structures(two_mass_model(1.5, 0.01, kTwoPi * 20.0, 0.01), {});
+  const Document doc = comparison_report(c);
+  const Table& t = must(find_table(must(find_section(doc, "Comparison")), "Structures tuned to the same spec"));
+  ASSERT_EQ(t.rows.size(), 3U);
+  EXPECT_EQ(t.rows[1][0], "pid");
+  EXPECT_EQ(t.rows[1][1].rfind("not tuned: no omega* meets", 0), 0U) << t.rows[1][1];
+  EXPECT_THROW((void)comparison_report({c[1]}), core::InputError);
+}
+
 TEST(TuningReport, BadOptionsAreInputErrors) {
   tuning::TuneOptions o;
   o.omega_star = 0.5;

@@ -6,6 +6,7 @@
 // against a brute-force search over the uncertainty's phase.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -51,35 +52,34 @@ Spec spec_of(const NormalizedPlant& plant, double kbw, double kff = 0.0) {
   return {i.peak_s, i.peak_tl, i.closed_loop_stable};
 }
 
-TEST(TuneLqg, AutomaticKbwIsTheFastestWithinTheLimits) {
-  const TuneResult r = tune(model(3.0, 0.01), lqg_options());
-  const Controller& c = r.controller;
-  ASSERT_TRUE(c.full_order.has_value());
-  const double kbw = c.full_order->weights.kbw;
-  EXPECT_EQ(c.structure, Structure::kLqg);
-  EXPECT_EQ(r.scan.size(), 36U);
-  // The chosen design meets the spec (to the search's peak resolution; kbw is chosen without
-  // feedforward) ...
-  const Spec at = spec_of(r.plant, kbw);
-  EXPECT_TRUE(at.stable);
-  EXPECT_LE(at.peak_s, 1.5 * (1.0 + 1e-3));
-  EXPECT_LE(at.peak_tl, 1.5 * (1.0 + 1e-3));
-  // ... and a 1 % faster one does not: the limit binds (brute force around the boundary).
-  const Spec faster = spec_of(r.plant, 0.99 * kbw);
-  EXPECT_TRUE(!faster.stable || faster.peak_s > 1.5 || faster.peak_tl > 1.5)
-      << "kbw " << kbw << ": " << faster.peak_s << " " << faster.peak_tl;
-  // Every slower scan point that met the spec is slower: no faster feasible design was skipped.
-  for (const TuneResult::Candidate& k : r.scan) {
-    if (k.feasible) {
-      EXPECT_GE(k.omega_star, kbw * (1.0 - 1e-9));
+TEST(TuneLqg, AutomaticKbwHasTheLargestLoadBandwidthWithinTheLimits) {
+  // Brute force: 61 kbw over [1e-4, 1e3], each tuned with that kbw given (and its automatic
+  // feedforward); the automatic choice must meet the spec and reach the best feasible load
+  // bandwidth of the dense scan (within 1 %). r = 5 is a plant where ‖S‖∞ hovers near Ms over
+  // decades of kbw (feasibility is not monotone in kbw).
+  for (const double r : {3.0, 5.0}) {
+    SCOPED_TRACE(r);
+    const TuneResult auto_result = tune(model(r, 0.01), lqg_options());
+    const Controller& c = auto_result.controller;
+    ASSERT_TRUE(c.full_order.has_value());
+    EXPECT_EQ(auto_result.scan.size(), 36U);
+    EXPECT_TRUE(c.predicted.closed_loop_stable);
+    EXPECT_LE(c.predicted.peak_s, 1.5 * (1.0 + 1e-3));
+    EXPECT_LE(c.predicted.peak_tl, 1.5 * (1.0 + 1e-3));
+    double best = 0.0;
+    for (const double kbw : core::log_space(1e-4, 1e3, 61)) {
+      TuneOptions o = lqg_options();
+      o.kbw = kbw;
+      const LoopIndices i = tune(model(r, 0.01), o).controller.predicted;
+      if (i.closed_loop_stable && i.peak_s <= 1.5 && i.peak_tl <= 1.5) best = std::max(best, i.bandwidth_load);
     }
+    ASSERT_GT(best, 0.0);
+    EXPECT_GE(c.predicted.bandwidth_load, 0.99 * best);
+    // The independent analysis of the chosen design agrees with the tuner's.
+    const Spec again = spec_of(auto_result.plant, c.full_order->weights.kbw, c.full_order->weights.feedforward);
+    EXPECT_NEAR(again.peak_tl, c.predicted.peak_tl, 1e-6);
+    EXPECT_NEAR(again.peak_s, c.predicted.peak_s, 1e-6);
   }
-  EXPECT_TRUE(c.predicted.closed_loop_stable);
-  // With the automatic feedforward the tracking peak is spent up to Mt; ‖S‖∞ does not change.
-  const Spec with_kff = spec_of(r.plant, kbw, c.full_order->weights.feedforward);
-  EXPECT_NEAR(c.predicted.peak_tl, with_kff.peak_tl, 1e-6);
-  EXPECT_NEAR(c.predicted.peak_tl, 1.5, 1e-3);
-  EXPECT_NEAR(with_kff.peak_s, at.peak_s, 1e-9);
 }
 
 TEST(TuneLqg, AutomaticFeedforwardIsTheScipyLimit) {
@@ -189,9 +189,9 @@ TEST(TuneLqg, WithW2TheChosenDesignPassesRobustTracking) {
   ASSERT_TRUE(rob.rp_tracking.has_value());
   EXPECT_LT(*rob.rp_tracking, 1.0);  // the search keeps a margin for its coarser grid
   EXPECT_LT(*rob.rs, 1.0);
-  // Without W2 the search may go faster, never slower.
+  // Without W2 the loop may get faster, never slower.
   const TuneResult nominal = tune(model(3.0, 0.01), lqg_options());
-  EXPECT_LE(nominal.controller.full_order->weights.kbw, r.controller.full_order->weights.kbw * (1.0 + 1e-9));
+  EXPECT_GE(nominal.controller.predicted.bandwidth_load, r.controller.predicted.bandwidth_load * (1.0 - 1e-3));
 }
 
 TEST(TuneLqg, BadOptionsAreInputErrors) {

@@ -16,6 +16,7 @@
 
 #include "servotwin/core/transfer_function.hpp"
 #include "servotwin/report/document.hpp"
+#include "servotwin/tuning/compare.hpp"
 #include "servotwin/tuning/tune.hpp"
 #include "servotwin/vcnc/drive_simulation.hpp"
 
@@ -53,5 +54,26 @@ struct TuningReportOptions {
 /// core::InputError (field "frequency_points" / "time_points") for options out of range, and
 /// "w2" for a weight that is improper or unstable.
 [[nodiscard]] Document tuning_report(const tuning::TuneResult& result, const TuningReportOptions& options = {});
+
+/// What the comparison report needs beyond the comparison.
+struct ComparisonReportOptions {
+  std::string source;                  ///< the plant's name or file, for the subtitle
+  std::size_t frequency_points = 400;  ///< log grid of the frequency charts, >= 16
+  std::size_t time_points = 1200;      ///< samples of each step response, >= 16
+};
+
+/// The structure comparison of C7.15 (`servotwin tune compare --report`):
+///  - "Comparison": the common spec and, per structure, the load bandwidth, ‖S‖∞, the tracking
+///    peak, ‖ωl/Tl‖∞ and the load-step ITAE (each also relative to the PI), the margins, the
+///    design parameter (ω* or kbw), the controller's own stability, or why it could not be tuned;
+///  - "Loop shapes": |ωl/ω*| (|ωm/ω*| without a load side) with Mt, |S| with Ms, and the
+///    closed-loop |ωl/Tl| of every structure beside the uncontrolled plant's;
+///  - "Time responses (linear)": the load velocity after a unit setpoint step and after a unit
+///    load-torque step, and the torque command of the setpoint step, every structure in one chart;
+///  - "Notes": each design's notes.
+/// core::InputError (field "comparison") when no structure has a design, and as tuning_report()
+/// for the point counts.
+[[nodiscard]] Document comparison_report(const std::vector<tuning::StructureComparison>& comparison,
+                                         const ComparisonReportOptions& options = {});
 
 }  // namespace servotwin::report

@@ -12,9 +12,10 @@
 /// result (indices, margins, time responses).
 ///
 /// lqg: the velocity LQG of C7.13 on the first mode's two-mass realization (with its viscous
-/// friction); kbw scanned from slow (1e3) to fast (1e-4) on a log grid and the boundary of the
-/// spec refined by bisection, then the feedforward kff raised (doubling, then bisection) while the
-/// spec holds; analysed through its 2-DoF form with the HF dynamics and higher modes included.
+/// friction); kbw scanned from slow (1e3) to fast (1e-4) on a log grid, each candidate with its
+/// largest feedforward kff within the spec (doubling, then bisection), the best load bandwidth
+/// chosen and its boundary refined by bisection; analysed through its 2-DoF form with the HF
+/// dynamics and higher modes included.
 
 #include <optional>
 #include <string>
@@ -49,9 +50,9 @@ struct TuneOptions {
   std::size_t scan_points = 24;         ///< automatic ω*: candidates on the admissible range
   /// lqg: the weights of C7.13 (their kbw and feedforward are ignored: see the next two).
   VelocityLqgOptions lqg;
-  /// lqg: the bandwidth knob; std::nullopt: the smallest kbw (fastest loop) that meets the same
-  /// spec as automatic ω* (stable with the HF dynamics, ‖S‖∞ <= Ms, tracking peak <= Mt and, with
-  /// W2, robust stability and C7.13's robust tracking test).
+  /// lqg: the bandwidth knob; std::nullopt: the kbw whose design, with its feedforward, has the
+  /// largest load bandwidth within the spec of automatic ω* (stable with the HF dynamics, ‖S‖∞ <= Ms,
+  /// tracking peak <= Mt and, with W2, robust stability and C7.13's robust tracking test).
   std::optional<double> kbw;
   /// lqg: kff; std::nullopt: the largest that keeps the spec above (C7.13: the tracking peak <= Mt).
   std::optional<double> feedforward;

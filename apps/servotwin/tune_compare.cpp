@@ -1,0 +1,126 @@
+// `servotwin tune compare PLANT [--structures pi,pid,lqg] [spec options] [--report compare.html]`:
+// every structure tuned to the same spec (catalog C7.15), a table on stdout, an interactive report.
+#include "tune_compare.hpp"
+
+#include <fmt/core.h>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "report_output.hpp"
+#include "servotwin/core/error.hpp"
+#include "servotwin/report/tuning_report.hpp"
+#include "servotwin/tuning/compare.hpp"
+#include "tune_input.hpp"
+#include "tune_options.hpp"
+
+namespace servotwin::cli {
+
+namespace {
+
+struct TuneCompareArgs {
+  std::string plant;
+  std::string structures = "pi,pid,lqg";
+  double target_r = 2.0;
+  TuneSpecArgs spec;
+  std::string report;
+};
+
+std::vector<tuning::Structure> parse_structures(const std::string& text) {
+  std::vector<tuning::Structure> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string name = text.substr(start, end - start);
+    const auto s = tuning::structure_from_string(name);
+    if (!s || *s == tuning::Structure::kPiP)
+      throw core::InputError(core::at_field("--structures"),
+                             "expected a comma-separated list of pi, pid, lqg, got \"" + name + "\"");
+    out.push_back(*s);
+    start = end + 1;
+  }
+  return out;
+}
+
+std::string comparison_cell(double v, const char* format = "{:.4g}") { return std::isfinite(v) ? fmt::format(fmt::runtime(format), v) : "-"; }
+std::string times_pi(double v) { return std::isfinite(v) ? fmt::format("x{:.2f}", v) : "-"; }
+
+void print_comparison(const std::vector<tuning::StructureComparison>& comparison) {
+  using tuning::LoopIndices;
+  const auto& plant = std::find_if(comparison.begin(), comparison.end(), [](const auto& c) { return c.result.has_value(); })
+                          ->result->plant;
+  const double hz = plant.omega_z / kTwoPi;
+  fmt::print("plant: antiresonance {:.4g} Hz, r = {:.4g}; spec: largest load bandwidth with ||S|| <= Ms and tracking "
+             "peak <= Mt (C7.15)\n",
+             hz, plant.r);
+  fmt::print("{:<6} {:>16} {:>12} {:>7} {:>7} {:>8} {:>11} {:>7} {:>9} {:>7} {:>9}  {}\n", "", "design", "load bw [Hz]",
+             "vs PI", "||S||", "tracking", "||wl/Tl||", "vs PI", "ITAE", "vs PI", "phase m.", "controller");
+  for (const tuning::StructureComparison& c : comparison) {
+    const std::string name = tuning::to_string(c.structure);
+    if (!c.result) {
+      fmt::print("{:<6} not tuned: {}\n", name, c.failure);
+      continue;
+    }
+    const tuning::Controller& k = c.result->controller;
+    const LoopIndices& i = k.predicted;
+    const bool load = !std::isnan(i.bandwidth_load);
+    const double bw = load ? i.bandwidth_load : i.bandwidth_motor;
+    const std::string design = k.full_order ? fmt::format("kbw {:.4g}", k.full_order->weights.kbw)
+                                            : fmt::format("w*/wz {:.4g}", k.design.omega_star);
+    const double velocity_per_torque = 1.0 / (plant.motor_inertia * plant.omega_z);
+    fmt::print("{:<6} {:>16} {:>12} {:>7} {:>7} {:>8} {:>11} {:>7} {:>9} {:>7} {:>9}  {}\n", name, design, comparison_cell(bw * hz),
+               times_pi(tuning::relative_to_pi(comparison, load ? &LoopIndices::bandwidth_load : &LoopIndices::bandwidth_motor, bw)),
+               comparison_cell(i.peak_s, "{:.3g}"), comparison_cell(load ? i.peak_tl : i.peak_tm, "{:.3g}"),
+               comparison_cell(i.peak_load_disturbance * velocity_per_torque),
+               times_pi(tuning::relative_to_pi(comparison, &LoopIndices::peak_load_disturbance, i.peak_load_disturbance)),
+               comparison_cell(i.itae_load_step), times_pi(tuning::relative_to_pi(comparison, &LoopIndices::itae_load_step, i.itae_load_step)),
+               comparison_cell(i.phase_margin_deg, "{:.3g}"),
+               k.full_order && !k.full_order->controller_stable ? "UNSTABLE compensator" : "stable");
+  }
+}
+
+int run_tune_compare(const TuneCompareArgs& a, const GlobalOptions& global) {
+  const auto start = std::chrono::steady_clock::now();
+  const TunePlant plant = load_tune_plant(a.plant);
+  const auto report_file = open_report(a.report, global);
+  tuning::TuneOptions options;
+  options.target_r = a.target_r;
+  apply_spec(a.spec, plant, options);
+  const std::vector<tuning::Structure> structures = parse_structures(a.structures);
+  const std::vector<tuning::StructureComparison> comparison = tuning::compare_structures(plant.model, options, structures);
+  progress(global, "tuned {} structures ({:.0f} ms)", comparison.size(), elapsed_ms(start));
+  print_comparison(comparison);
+  if (report_file) {
+    report::ComparisonReportOptions report_options;
+    report_options.source = a.plant;
+    write_report(report::comparison_report(comparison, report_options), *report_file, global);
+  }
+  return kSuccess;
+}
+
+}  // namespace
+
+void add_tune_compare(CLI::App& tune, Action& selected) {
+  auto a = std::make_shared<TuneCompareArgs>();
+  CLI::App* cmd = tune.add_subcommand(
+      "compare", "Tune PI, PID and LQG to the same spec on one plant and compare them (catalog C7.15)");
+  cmd->add_option("plant", a->plant,
+                  "Plant: a fitted model (servotwin.plant-model/1), a plant description (servotwin.plant/1) or a "
+                  "flexible preset name")
+      ->required();
+  cmd->add_option("--structures", a->structures, "Comma-separated structures to compare (pi, pid, lqg)")
+      ->capture_default_str();
+  cmd->add_option("--target-r", a->target_r, "PID: virtual resonance ratio r-bar (C7.15 uses 2)")->capture_default_str();
+  add_spec_options(*cmd, a->spec);
+  add_report_option(*cmd, a->report);
+  set_examples(*cmd,
+               "  servotwin tune compare table-5.1\n"
+               "  servotwin tune compare plant_model.json --delay 0.0005 --report compare.html\n"
+               "  servotwin tune compare motor-bench --structures pi,lqg --ms 1.6 --mt 1.3\n");
+  cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run_tune_compare(*a, g); }; });
+}
+
+}  // namespace servotwin::cli

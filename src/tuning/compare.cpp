@@ -1,0 +1,49 @@
+#include "servotwin/tuning/compare.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "servotwin/core/error.hpp"
+
+namespace servotwin::tuning {
+
+std::vector<Structure> comparison_structures() { return {Structure::kPi, Structure::kPid, Structure::kLqg}; }
+
+std::vector<StructureComparison> compare_structures(const fit::PlantModel& model, const TuneOptions& options,
+                                                    const std::vector<Structure>& structures) {
+  std::vector<StructureComparison> out;
+  std::optional<core::InputError> first_failure;
+  for (const Structure s : structures) {
+    if (s == Structure::kPiP)
+      throw core::InputError(core::at_field("structures"),
+                             "expected velocity-loop structures (pi, pid, lqg): pi+p closes the position loop");
+    StructureComparison entry;
+    entry.structure = s;
+    TuneOptions o = options;
+    o.structure = s;
+    o.allow_negative_kd = true;
+    try {
+      entry.result = tune(model, o);
+    } catch (const core::InputError& e) {
+      entry.failure = e.reason();
+      if (!first_failure) first_failure = e;
+    }
+    out.push_back(std::move(entry));
+  }
+  // What fails every structure (the plant, the options) is the caller's error, not a comparison.
+  const bool any = std::any_of(out.begin(), out.end(), [](const StructureComparison& c) { return c.result.has_value(); });
+  if (!any && first_failure) throw *first_failure;
+  return out;
+}
+
+double relative_to_pi(const std::vector<StructureComparison>& comparison, double LoopIndices::*index, double value) {
+  for (const StructureComparison& c : comparison) {
+    if (c.structure != Structure::kPi || !c.result) continue;
+    const double pi = c.result->controller.predicted.*index;
+    if (std::isfinite(pi) && pi != 0.0) return value / pi;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace servotwin::tuning

@@ -1,0 +1,87 @@
+// The structure comparison of C7.15 (tuning/compare.hpp). References: the dissertation's printed
+// conclusions (catalog C7.15 [P]): r < 1.3 nothing helps; for r > 2.3 full order wins, the PID
+// tuned to r̄ = 2 gains up to +45 % and LQG/H∞ up to +100 % load bandwidth over the PI; each entry
+// is the tuner's own design (the same numbers as `servotwin tune --structure ...`).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "fixture.hpp"
+#include "servotwin/core/error.hpp"
+#include "servotwin/tuning/compare.hpp"
+
+namespace servotwin::tuning {
+namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace compare_test {
+
+fit::PlantModel frictionless(double r) {
+  fit::PlantModel m;
+  m.rigid = fit::RigidKind::kIntegrator;
+  m.gain = 1.0;
+  m.modes = {{{1.0, 0.01}, {r, r * 0.01}}};
+  return m;
+}
+
+const StructureComparison& entry(const std::vector<StructureComparison>& c, Structure s) {
+  for (const StructureComparison& e : c)
+    if (e.structure == s) return e;
+  throw std::logic_error("structure missing");
+}
+
+double load_bandwidth(const StructureComparison& e) { return e.result->controller.predicted.bandwidth_load; }
+
+TEST(CompareStructures, EachEntryIsTheTunersDesign) {
+  const std::vector<StructureComparison> c = compare_structures(frictionless(3.0), {});
+  ASSERT_EQ(c.size(), 3U);
+  for (const StructureComparison& e : c) {
+    ASSERT_TRUE(e.result.has_value()) << to_string(e.structure) << ": " << e.failure;
+    TuneOptions o;
+    o.structure = e.structure;
+    o.allow_negative_kd = true;
+    EXPECT_EQ(tune(frictionless(3.0), o).controller.predicted.bandwidth_load, load_bandwidth(e));
+    EXPECT_LE(e.result->controller.predicted.peak_s, 1.5 * (1.0 + 1e-3));
+    EXPECT_LE(e.result->controller.predicted.peak_tl, 1.5 * (1.0 + 1e-3));
+  }
+  EXPECT_DOUBLE_EQ(relative_to_pi(c, &LoopIndices::bandwidth_load, load_bandwidth(c.front())), 1.0);
+}
+
+TEST(CompareStructures, FullOrderWinsAboveRatio23AsThePrintedConclusionsSay) {
+  for (const double r : {3.0, 4.0, 5.0, 8.0}) {
+    SCOPED_TRACE(r);
+    const std::vector<StructureComparison> c = compare_structures(frictionless(r), {});
+    const double pi = load_bandwidth(entry(c, Structure::kPi));
+    const double pid = load_bandwidth(entry(c, Structure::kPid));
+    const double lqg = load_bandwidth(entry(c, Structure::kLqg));
+    EXPECT_GT(pid, pi);                    // the PID gains ...
+    EXPECT_LT(pid, 1.45 * pi);             // ... up to +45 %
+    EXPECT_GT(lqg, 1.4 * pi);              // full order: well above the PI ...
+    EXPECT_LT(lqg, 2.0 * pi);              // ... up to +100 %
+    EXPECT_GT(lqg, pid);
+  }
+}
+
+TEST(CompareStructures, AStructureThatCannotMeetTheSpecIsRecorded) {
+  // r = 1.5 < r̄ = 2: the PID needs a negative Kd and no ω* keeps ‖S‖∞ <= 1.5; PI and LQG design.
+  const std::vector<StructureComparison> c = compare_structures(frictionless(1.5), {});
+  EXPECT_FALSE(entry(c, Structure::kPid).result.has_value());
+  EXPECT_NE(entry(c, Structure::kPid).failure.find("no omega* meets"), std::string::npos);
+  EXPECT_TRUE(entry(c, Structure::kPi).result.has_value());
+  EXPECT_TRUE(entry(c, Structure::kLqg).result.has_value());
+  EXPECT_TRUE(std::isnan(relative_to_pi({entry(c, Structure::kPid)}, &LoopIndices::bandwidth_load, 1.0)));
+}
+
+TEST(CompareStructures, WhatFailsEveryStructureIsTheCallersError) {
+  // r = 1.2: nothing helps (C7.15); the tuner's message, not an empty comparison.
+  test::expect_input_error([] { (void)compare_structures(frictionless(1.2), {}); }, "plant", "passive methods");
+  TuneOptions o;
+  o.ms = 0.5;
+  test::expect_input_error([&] { (void)compare_structures(frictionless(3.0), o); }, "--ms", "> 1");
+  test::expect_input_error([] { (void)compare_structures(frictionless(3.0), {}, {Structure::kPi, Structure::kPiP}); },
+                           "structures", "velocity-loop");
+}
+
+}  // namespace compare_test
+}  // namespace
+}  // namespace servotwin::tuning
