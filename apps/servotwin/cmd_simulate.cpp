@@ -73,7 +73,6 @@ vcnc::DriveSimulation simulate(const machine::PlantConfig& plant, const std::str
 }
 
 /// A time or "never" for a run that did not get there.
-std::string time_or_never(double t) { return std::isfinite(t) ? fmt::format("{:.4g} s", t) : "never"; }
 
 void print_metrics(const char* label, const vcnc::DriveMetrics& m, vcnc::DriveTest test) {
   if (test == vcnc::DriveTest::kSetpointStep) {

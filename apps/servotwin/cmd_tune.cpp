@@ -32,6 +32,7 @@ struct TuneArgs {
   std::string omega_star = "auto";
   std::string kbw = "auto", kff = "auto";
   bool raw_motor_velocity = false;
+  std::optional<double> measurement_noise;
   double target_r = 2.0;
   std::optional<double> tau;
   bool allow_negative_kd = false;
@@ -59,6 +60,10 @@ tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
   o.kbw = parse_auto(a.kbw, "--kbw", false, "a bandwidth knob > 0");
   o.feedforward = parse_auto(a.kff, "--kff", true, "a normalized feedforward gain >= 0");
   o.lqg.raw_motor_velocity = a.raw_motor_velocity;
+  if (a.measurement_noise) {
+    o.lqg.measurement_noise = *a.measurement_noise;  // the user's V is kept, not raised
+    o.raise_measurement_noise = false;
+  }
   o.target_r = a.target_r;
   o.tau = a.tau;
   o.allow_negative_kd = a.allow_negative_kd;
@@ -146,15 +151,14 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
 void print_verification(const vcnc::DriveSimulation& sim) {
   const vcnc::DriveMetrics& m = sim.metrics;
   const vcnc::DriveMetrics& l = sim.linear_metrics;
-  const auto time = [](double t) { return std::isfinite(t) ? fmt::format("{:.4g} s", t) : std::string("never"); };
   if (sim.test == vcnc::DriveTest::kSetpointStep) {
     fmt::print("  step of {:g}: overshoot {:.1f} % (linear {:.1f} %), settling {} (linear {}), final error {:.3g}\n",
-               sim.amplitude, 100.0 * m.overshoot, 100.0 * l.overshoot, time(m.settling_time), time(l.settling_time),
+               sim.amplitude, 100.0 * m.overshoot, 100.0 * l.overshoot, time_or_never(m.settling_time), time_or_never(l.settling_time),
                m.final_error);
   } else {
     fmt::print("  load step of {:.4g}: peak deviation {:.4g} (linear {:.4g}), recovery {} (linear {}), final deviation "
                "{:.3g} (linear {:.3g})\n",
-               sim.amplitude, m.peak_deviation, l.peak_deviation, time(m.recovery_time), time(l.recovery_time),
+               sim.amplitude, m.peak_deviation, l.peak_deviation, time_or_never(m.recovery_time), time_or_never(l.recovery_time),
                0.0 - m.final_error, 0.0 - l.final_error);
   }
   for (const std::string& n : sim.notes) fmt::print("  note: {}\n", n);
@@ -237,6 +241,9 @@ void register_tune(CLI::App& app, Action& selected) {
       ->capture_default_str();
   cmd->add_flag("--raw-motor-velocity", a->raw_motor_velocity,
                 "LQG: feed back the measured motor velocity instead of its estimate (C7.13 variant)");
+  cmd->add_option("--measurement-noise", a->measurement_noise,
+                  "LQG: Kalman-filter measurement-noise intensity V; larger = a slower estimator, for loops with "
+                  "delay or a noisy encoder (default: C7.13's 0.1, raised by decades when no kbw meets the spec)");
   cmd->add_option("--target-r", a->target_r, "PID: virtual resonance ratio r-bar the derivative gain creates")
       ->capture_default_str();
   cmd->add_option("--tau", a->tau, "PID: derivative filter time constant [s] (default: 1/max(r, 5 omega*) in omega_z units)");

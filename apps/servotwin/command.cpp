@@ -71,4 +71,8 @@ double elapsed_ms(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+std::string time_or_never(double seconds) {
+  return std::isfinite(seconds) ? fmt::format("{:.4g} s", seconds) : std::string("never");
+}
+
 }  // namespace servotwin::cli

@@ -89,4 +89,7 @@ void set_examples(CLI::App& command, const std::string& examples);
 /// Milliseconds elapsed since `start` (steady clock, for progress messages).
 double elapsed_ms(std::chrono::steady_clock::time_point start);
 
+/// "0.1234 s", or "never" for a time that was not reached (+infinity: not settled, not risen).
+std::string time_or_never(double seconds);
+
 }  // namespace servotwin::cli

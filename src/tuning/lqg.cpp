@@ -61,18 +61,12 @@ Eigen::VectorXd estimator(const Matrix& a, const Matrix& c, const Matrix& w, dou
   return (y * c.transpose()).col(0) / v;
 }
 
-/// Plant + compensator closed loop (reference and load torque set to zero): its poles.
+/// Plant + compensator closed loop (reference and load torque set to zero): its poles. The
+/// compensator's measurement channel u = K_y y carries its own sign: positive feedback.
 std::vector<Complex> closed_loop_poles(const core::StateSpace& plant, const core::StateSpace& c) {
-  // Plant x' = A x + Bu u (+ Bt Tl), y = C₀ x (first output); u = Cc xc + Dc [r, y].
-  const Eigen::Index n = plant.A.rows(), m = c.A.rows();
-  const Matrix bu = plant.B.col(0);
-  const Matrix cy = plant.C.row(0);
-  Matrix a(n + m, n + m);
-  a.topLeftCorner(n, n) = plant.A + bu * c.D(0, 1) * cy;
-  a.topRightCorner(n, m) = bu * c.C;
-  a.bottomLeftCorner(m, n) = c.B.col(1) * cy;
-  a.bottomRightCorner(m, m) = c.A;
-  return poles_of(a);
+  const core::StateSpace torque_to_measurement{plant.A, plant.B.col(0), plant.C.row(0), plant.D.block(0, 0, 1, 1)};
+  const core::StateSpace measurement_to_torque{c.A, c.B.col(1), c.C, c.D.col(1)};
+  return poles_of(core::feedback(torque_to_measurement, measurement_to_torque, +1).A);
 }
 
 /// The estimator's model: the plant's states plus a constant load torque, input Tm, output y.

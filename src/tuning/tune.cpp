@@ -348,17 +348,45 @@ Feedforward automatic_feedforward(const LqgDesigner& lqg, const SpecCheck& check
 /// the feedforward, not only the feedback, sets the tracking bandwidth; feasibility in kbw need not
 /// be monotone (‖S‖∞ hovers near Ms over decades of kbw on high-r plants), so the whole scan is
 /// ranked, then the boundary next to the best refined by bisection.
-double automatic_kbw(const LqgDesigner& lqg, const SpecCheck& check, const std::optional<double>& given_kff,
-                     TuneResult& result) {
+/// std::nullopt when no kbw meets the spec (the scan is in `scan` either way).
+std::optional<double> automatic_kbw(const LqgDesigner& lqg, const SpecCheck& check,
+                                    const std::optional<double>& given_kff, std::vector<TuneResult::Candidate>& scan) {
   constexpr int kRankingBisections = 12;
   const auto evaluate = [&](double kbw) {
     const double kff = given_kff ? *given_kff : automatic_feedforward(lqg, check, kbw, kRankingBisections).kff;
     return check(kbw, lqg.loop(lqg.design(kbw, kff)));
   };
-  for (double kbw : kbw_candidates()) result.scan.push_back(evaluate(kbw));
-  const TuneResult::Candidate chosen = choose(result.scan, evaluate);
-  if (!chosen.feasible) no_feasible_omega(result.scan, check.options);
+  scan.clear();
+  for (double kbw : kbw_candidates()) scan.push_back(evaluate(kbw));
+  const TuneResult::Candidate chosen = choose(scan, evaluate);
+  if (!chosen.feasible) return std::nullopt;
   return chosen.omega_star;
+}
+
+/// Automatic kbw; when nothing meets the spec with the options' measurement noise V, V is raised
+/// by decades (at most kMaxNoiseDecades, when allowed): C7.13's estimator has a fixed bandwidth
+/// (its weights do not scale with kbw), too high for a loop with delay, and a larger V slows it.
+void choose_kbw(const NormalizedPlant& plant, const FrictionTwoMass& model, const TuneOptions& options,
+                const SpecCheck& check, FullOrderSummary& f, TuneResult& result) {
+  constexpr int kMaxNoiseDecades = 4;
+  const double printed = f.weights.measurement_noise;
+  for (int decade = 0;; ++decade) {
+    const LqgDesigner lqg{plant, model, f.weights};
+    if (const std::optional<double> kbw = automatic_kbw(lqg, check, options.feedforward, result.scan)) {
+      f.weights.kbw = *kbw;
+      break;
+    }
+    if (!options.raise_measurement_noise || decade == kMaxNoiseDecades) no_feasible_omega(result.scan, options);
+    f.weights.measurement_noise *= 10.0;
+  }
+  f.kbw_source = options.w2 ? "largest load bandwidth with ||S|| <= Ms, tracking peak <= Mt and robust tracking"
+                            : "largest load bandwidth with ||S|| <= Ms and tracking peak <= Mt";
+  if (f.weights.measurement_noise != printed) {
+    result.controller.notes.push_back(fmt::format(
+        "no kbw met the spec with the Kalman filter's measurement noise V = {:g}: V raised to {:g} (a slower "
+        "estimator; the estimator of C7.13's weights is too fast for this loop's delay or lags)",
+        printed, f.weights.measurement_noise));
+  }
 }
 
 std::string pole_list(const std::vector<std::complex<double>>& poles) {
@@ -374,7 +402,7 @@ std::string pole_list(const std::vector<std::complex<double>>& poles) {
 /// The LQG path of tune(): kbw and kff, the compensator, its analysis and robustness.
 void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
   const NormalizedPlant& plant = result.plant;
-  const LqgDesigner lqg{plant, lqg_design_model(plant), options.lqg};
+  const FrictionTwoMass model = lqg_design_model(plant);
   Controller& c = result.controller;
   FullOrderSummary f;
   f.weights = options.lqg;
@@ -382,10 +410,9 @@ void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& c
     f.weights.kbw = *options.kbw;
     f.kbw_source = "given";
   } else {
-    f.weights.kbw = automatic_kbw(lqg, check, options.feedforward, result);
-    f.kbw_source = options.w2 ? "largest load bandwidth with ||S|| <= Ms, tracking peak <= Mt and robust tracking"
-                              : "largest load bandwidth with ||S|| <= Ms and tracking peak <= Mt";
+    choose_kbw(plant, model, options, check, f, result);
   }
+  const LqgDesigner lqg{plant, model, f.weights};
   if (options.feedforward) {
     f.weights.feedforward = *options.feedforward;
     f.feedforward_source = "given";

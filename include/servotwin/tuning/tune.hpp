@@ -56,6 +56,9 @@ struct TuneOptions {
   std::optional<double> kbw;
   /// lqg: kff; std::nullopt: the largest that keeps the spec above (C7.13: the tracking peak <= Mt).
   std::optional<double> feedforward;
+  /// lqg with automatic kbw: when no kbw meets the spec, raise lqg.measurement_noise by decades (up
+  /// to 10⁴ times) and search again (a note says so); false: fail with the tuner's message.
+  bool raise_measurement_noise = true;
 };
 
 /// Everything the tuner found, for the CLI summary, the controller file and the report.
