@@ -7,6 +7,7 @@
 
 #include "checks.hpp"
 #include "servotwin/core/error.hpp"
+#include "servotwin/core/norms.hpp"
 #include "servotwin/core/riccati.hpp"
 
 namespace servotwin::tuning {
@@ -235,6 +236,50 @@ ControllerTf two_dof_form(const core::StateSpace& c) {
   // algebra sees one denominator (they differ only by rounding).
   const core::Polynomial& den = measurement.den();
   return {core::TransferFunction(-1.0 * measurement.num(), den), core::TransferFunction(reference.num(), den)};
+}
+
+ControllerTf velocity_form(const ControllerTf& position) {
+  const core::Polynomial s{1.0, 0.0};
+  const core::Polynomial den = position.feedback.den() * s;
+  return {core::TransferFunction(position.feedback.num(), den), core::TransferFunction(position.reference.num() * s, den)};
+}
+
+double prefilter_time_constant(const VelocityLoop& loop, std::span<const double> grid, double peak_limit) {
+  if (!loop.has_load()) throw std::invalid_argument("prefilter_time_constant: the loop has no load side");
+  if (!(peak_limit > 0.0)) throw std::invalid_argument("prefilter_time_constant: the peak limit must be > 0");
+  const auto peak = [&](double tau) {
+    const auto f = [&](double w) {
+      const Complex jw(0.0, w);
+      return loop.load_tracking(w) / jw / (tau * jw + 1.0);
+    };
+    return core::peak_on_grid(f, grid, 1e-9).value;
+  };
+  if (peak(0.0) <= peak_limit) return 0.0;
+  double lo = 0.0, hi = 1.0;
+  while (peak(hi) > peak_limit) {
+    lo = hi;
+    hi *= 2.0;
+    if (hi > 1e9) throw std::invalid_argument("prefilter_time_constant: no prefilter meets the limit (static gain above it?)");
+  }
+  while (hi - lo > 1e-9 * hi) {
+    const double mid = 0.5 * (lo + hi);
+    (peak(mid) > peak_limit ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+core::StateSpace with_prefilter(const core::StateSpace& c, double tau) {
+  if (tau == 0.0) return c;
+  // F: x' = (r − x)/τ, y = x, feeding the compensator's reference input; the measurement passes.
+  core::StateSpace f;
+  f.A = Matrix::Constant(1, 1, -1.0 / tau);
+  f.B = Matrix::Zero(1, 2);
+  f.B(0, 0) = 1.0 / tau;
+  f.C = Matrix::Zero(2, 1);
+  f.C(0, 0) = 1.0;
+  f.D = Matrix::Zero(2, 2);
+  f.D(1, 1) = 1.0;
+  return core::series(f, c);
 }
 
 }  // namespace servotwin::tuning

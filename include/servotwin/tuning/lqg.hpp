@@ -26,6 +26,7 @@
 /// it is stable, as a drive commissioner must know before switching it on.
 
 #include <complex>
+#include <span>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -90,5 +91,24 @@ struct LqgDesign {
 /// VelocityLoop built from it gives every loop function of the LQG loop. std::invalid_argument
 /// unless the compensator has 2 inputs and 1 output.
 [[nodiscard]] ControllerTf two_dof_form(const core::StateSpace& compensator);
+
+/// A position controller u = C1 φ* − C2 φm in the velocity form a VelocityLoop takes (reference
+/// input still φ*, measurement ωm = s φm): feedback C2/s and reference C1, both over den·s. On a
+/// VelocityLoop built from it, S, T and the margins are the position loop's, and ωm/φ*, ωl/φ*,
+/// ωl/Tl divided by jω are φm/φ*, φl/φ*, φl/Tl.
+[[nodiscard]] ControllerTf velocity_form(const ControllerTf& position);
+
+/// C7.13's reference prefilter F = 1/(τ s + 1) of the position LQG: the smallest τ >= 0 with
+/// sup_ω |F φl/φ*| <= peak_limit (1: the load position does not overshoot in frequency) on a
+/// VelocityLoop of velocity_form(); `grid` the normalized frequencies of the peak search. |F(jω)|
+/// falls as τ grows at every ω, so the peak is non-increasing in τ and a bisection (to 1e-9
+/// relative) finds the boundary. 0 when the loop meets the limit without a prefilter.
+/// std::invalid_argument for a loop without a load side or a limit <= 0.
+[[nodiscard]] double prefilter_time_constant(const VelocityLoop& velocity_form_loop, std::span<const double> grid,
+                                             double peak_limit = 1.0);
+
+/// The compensator with the prefilter 1/(τ s + 1) on its reference input (one more state, first);
+/// τ = 0 returns it unchanged.
+[[nodiscard]] core::StateSpace with_prefilter(const core::StateSpace& compensator, double tau);
 
 }  // namespace servotwin::tuning
