@@ -1,5 +1,6 @@
 // `servotwin tune compare PLANT [--structures pi,pid,lqg] [spec options] [--report compare.html]`:
-// every structure tuned to the same spec (catalog C7.15), a table on stdout, an interactive report.
+// every structure tuned to the same spec (catalog C7.15), a table on stdout, the designs run on a
+// plant description with its nonlinearities, an interactive report.
 #include "tune_compare.hpp"
 
 #include <fmt/core.h>
@@ -7,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,7 @@
 #include "servotwin/core/error.hpp"
 #include "servotwin/report/tuning_report.hpp"
 #include "servotwin/tuning/compare.hpp"
+#include "servotwin/vcnc/drive_simulation.hpp"
 #include "tune_input.hpp"
 #include "tune_options.hpp"
 
@@ -82,6 +85,42 @@ void print_comparison(const std::vector<tuning::StructureComparison>& comparison
   }
 }
 
+/// Every design run on the plant description with its nonlinearities: a unit setpoint step, then a
+/// load step of the same height for all (the first design's linear peak torque of its step, so the
+/// torque level fits the plant's units). Printed as one table; a run that cannot be made is a note.
+std::vector<vcnc::DriveSimulation> simulate_on_plant(const TunePlant& plant,
+                                                     const std::vector<tuning::StructureComparison>& comparison) {
+  std::vector<vcnc::DriveSimulation> runs;
+  if (!plant.description) return runs;
+  fmt::print("on the plant with its nonlinearities (plant / linear part):\n");
+  fmt::print("{:<6} {:>21} {:>23} {:>12} | {:>19} {:>23}\n", "", "step overshoot [%]", "settling", "final error",
+             "load-step peak dev.", "recovery");
+  std::optional<double> load_torque;
+  for (const tuning::StructureComparison& c : comparison) {
+    if (!c.result) continue;
+    const std::string name = tuning::to_string(c.structure);
+    try {
+      const vcnc::DriveSimulation step = vcnc::simulate_drive(*plant.description, c.result->controller);
+      if (!load_torque) load_torque = step.linear_metrics.peak_torque;
+      vcnc::DriveSimulationSettings settings;
+      settings.test = vcnc::DriveTest::kLoadStep;
+      settings.amplitude = *load_torque;
+      const vcnc::DriveSimulation load = vcnc::simulate_drive(*plant.description, c.result->controller, settings);
+      const vcnc::DriveMetrics &m = step.metrics, &l = step.linear_metrics, &ml = load.metrics, &ll = load.linear_metrics;
+      fmt::print("{:<6} {:>10.1f} / {:>8.1f} {:>11} / {:>9} {:>12.3g} | {:>9.4g} / {:>7.4g} {:>11} / {:>9}\n", name,
+                 100.0 * m.overshoot, 100.0 * l.overshoot, time_or_never(m.settling_time), time_or_never(l.settling_time),
+                 m.final_error, ml.peak_deviation, ll.peak_deviation, time_or_never(ml.recovery_time),
+                 time_or_never(ll.recovery_time));
+      runs.push_back(step);
+      runs.push_back(load);
+    } catch (const core::InputError& e) {
+      fmt::print("{:<6} not simulated: {}\n", name, e.what());
+    }
+  }
+  if (load_torque) fmt::print("(load step: {:.4g} N m for every structure)\n", *load_torque);
+  return runs;
+}
+
 int run_tune_compare(const TuneCompareArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   const TunePlant plant = load_tune_plant(a.plant);
@@ -93,9 +132,11 @@ int run_tune_compare(const TuneCompareArgs& a, const GlobalOptions& global) {
   const std::vector<tuning::StructureComparison> comparison = tuning::compare_structures(plant.model, options, structures);
   progress(global, "tuned {} structures ({:.0f} ms)", comparison.size(), elapsed_ms(start));
   print_comparison(comparison);
+  std::vector<vcnc::DriveSimulation> runs = simulate_on_plant(plant, comparison);
   if (report_file) {
     report::ComparisonReportOptions report_options;
     report_options.source = a.plant;
+    report_options.simulations = std::move(runs);
     write_report(report::comparison_report(comparison, report_options), *report_file, global);
   }
   return kSuccess;

@@ -14,6 +14,7 @@
 #include "servotwin/core/state_space.hpp"
 #include "servotwin/report/tuning_report.hpp"
 #include "servotwin/tuning/velocity_loop.hpp"
+#include "servotwin/vcnc/drive_simulation.hpp"
 #include "chart_helpers.hpp"
 
 namespace servotwin::report {
@@ -208,6 +209,55 @@ Section time_section(const Context& c) {
   return s;
 }
 
+std::string time_cell(double t) { return std::isfinite(t) ? num(t) : "never"; }
+
+/// The runs of one test, every structure in one table and one chart per signal.
+Section simulation_section(const std::vector<const vcnc::DriveSimulation*>& runs, vcnc::DriveTest test) {
+  Section s;
+  s.title = fmt::format("Simulation on the plant: {}", vcnc::to_string(test));
+  const bool step = test == vcnc::DriveTest::kSetpointStep;
+  s.text = fmt::format(
+      "Each design discretized at the plant's sample period closes the loop around the plant with its "
+      "nonlinearities (friction, backlash, quantization, noise, delay); \"linear\" is the same loop on the "
+      "plant's linear part. {} of {} for every structure.",
+      step ? "A setpoint step" : "A load-torque step", num(runs.front()->amplitude));
+  Table t;
+  t.title = "Metrics of the controlled variable";
+  t.header = step ? std::vector<std::string>{"structure", "overshoot [%]", "linear", "settling [s]", "linear",
+                                             "final error", "peak torque", "limit active [%]"}
+                  : std::vector<std::string>{"structure", "peak deviation", "linear", "recovery [s]", "linear",
+                                             "final deviation", "peak torque", "limit active [%]"};
+  Chart value{step ? "Controlled variable after the setpoint step" : "Controlled variable after the load-torque step",
+              "time [s]", "controlled variable [plant units]", {}, {}, {}, false};
+  Chart torque{"Torque command", "time [s]", "torque [N m]", {}, {}, {}, false};
+  for (const vcnc::DriveSimulation* run : runs) {
+    const vcnc::DriveMetrics &m = run->metrics, &l = run->linear_metrics;
+    const std::string name = tuning::to_string(run->structure);
+    if (step) {
+      t.rows.push_back({name, num(100.0 * m.overshoot), num(100.0 * l.overshoot), time_cell(m.settling_time),
+                        time_cell(l.settling_time), num(m.final_error), num(m.peak_torque),
+                        num(100.0 * m.saturated_fraction)});
+    } else {
+      t.rows.push_back({name, num(m.peak_deviation), num(l.peak_deviation), time_cell(m.recovery_time),
+                        time_cell(l.recovery_time), num(-m.final_error), num(m.peak_torque),
+                        num(100.0 * m.saturated_fraction)});
+    }
+    const vcnc::ControlledVariable controlled = vcnc::controlled_variable(*run);
+    Series v{name, {}, {}}, u{name, {}, {}};
+    for (const vcnc::DriveSample& sample : run->samples) {
+      v.x.push_back(sample.t);
+      v.y.push_back(controlled(sample));
+      u.x.push_back(sample.t);
+      u.y.push_back(sample.torque_command);
+    }
+    value.series.push_back(std::move(v));
+    torque.series.push_back(std::move(u));
+  }
+  s.tables.push_back(std::move(t));
+  s.charts = {std::move(value), std::move(torque)};
+  return s;
+}
+
 Section notes_section(const Context& c) {
   Section s;
   s.title = "Notes";
@@ -240,7 +290,14 @@ Document comparison_report(const std::vector<StructureComparison>& comparison, c
   doc.title = "servotwin tune compare: controller structures";
   doc.subtitle = fmt::format("{}{}antiresonance {} Hz, r = {}", options.source, options.source.empty() ? "" : ": ",
                              num(plant.omega_z / kTwoPi), num(plant.r));
-  doc.sections = {comparison_section(c), loop_section(c), time_section(c), notes_section(c)};
+  doc.sections = {comparison_section(c), loop_section(c), time_section(c)};
+  for (const vcnc::DriveTest test : {vcnc::DriveTest::kSetpointStep, vcnc::DriveTest::kLoadStep}) {
+    std::vector<const vcnc::DriveSimulation*> runs;
+    for (const vcnc::DriveSimulation& sim : options.simulations)
+      if (sim.test == test) runs.push_back(&sim);
+    if (!runs.empty()) doc.sections.push_back(simulation_section(runs, test));
+  }
+  doc.sections.push_back(notes_section(c));
   return doc;
 }
 

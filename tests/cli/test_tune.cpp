@@ -95,7 +95,10 @@ TEST_F(Cli, TuneCompareTunesEveryStructureToOneSpec) {
   EXPECT_NE(r.out.find("spec: largest load bandwidth"), std::string::npos) << r.out;
   for (const char* row : {"\npi ", "\npid ", "\nlqg "}) EXPECT_NE(r.out.find(row), std::string::npos) << row << r.out;
   EXPECT_NE(r.out.find("x1.00"), std::string::npos) << r.out;
-  EXPECT_NE(slurp(path("compare.html")).find("Structures tuned to the same spec"), std::string::npos);
+  EXPECT_NE(r.out.find("on the plant with its nonlinearities"), std::string::npos) << r.out;
+  const std::string html = slurp(path("compare.html"));
+  EXPECT_NE(html.find("Structures tuned to the same spec"), std::string::npos);
+  EXPECT_NE(html.find("Simulation on the plant: load-step"), std::string::npos);
   // The same numbers as the single-structure command.
   const Result lqg = run("tune table-5.1 --structure lqg");
   ASSERT_EQ(lqg.status, 0) << lqg.err;

@@ -21,6 +21,7 @@
 #include "report_test_support.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/fit/plant_model.hpp"
+#include "servotwin/machine/flexible_plant.hpp"
 #include "servotwin/report/tuning_report.hpp"
 #include "servotwin/tuning/position_loop.hpp"
 #include "servotwin/tuning/velocity_loop.hpp"
@@ -426,6 +427,43 @@ TEST(ComparisonReport, OneTableAndEveryStructureInEachChart) {
   const Chart& load_steps = must(find_chart(must(find_section(doc, "Time responses (linear)")),
                                             "Load velocity after a unit load-torque step"));
   for (const Series& series : load_steps.series) EXPECT_NEAR(series.y.back(), 0.0, 1e-3) << series.label;
+}
+
+TEST(ComparisonReport, SimulationsOnThePlantAreOneSectionPerTest) {
+  // The compared designs run on a two-mass plant with friction (as in test_drive_report.cpp): a
+  // section per test, one table row and one overlaid series per structure, the samples unchanged.
+  machine::PlantConfig plant;
+  plant.model = machine::two_mass(1.0, 3.0, 3.0, 0.12);
+  auto& chain = std::get<machine::MassChain>(plant.model);
+  chain.friction = {machine::KarnoppFriction{}, machine::KarnoppFriction{0.02, 0.03, 1e-3}};
+  plant.settings.ts = 5e-3;
+  const auto tf = machine::mass_chain_transfer_function(chain, machine::PlantOutput::MotorVelocity);
+  const std::vector<tuning::StructureComparison> c =
+      tuning::compare_structures(fit::plant_model_from_transfer_function(tf), {});
+  ComparisonReportOptions o;
+  for (const auto& e : c) {
+    ASSERT_TRUE(e.result.has_value()) << e.failure;
+    vcnc::DriveSimulationSettings s;
+    s.duration_s = 20.0;
+    o.simulations.push_back(vcnc::simulate_drive(plant, e.result->controller, s));
+    s.test = vcnc::DriveTest::kLoadStep;
+    s.amplitude = 0.3;
+    o.simulations.push_back(vcnc::simulate_drive(plant, e.result->controller, s));
+  }
+  const Document doc = comparison_report(c, o);
+  expect_html_has_every_chart(doc, 5'000'000);
+  for (const char* title : {"Simulation on the plant: step", "Simulation on the plant: load-step"}) {
+    const Section& s = must(find_section(doc, title));
+    ASSERT_EQ(s.tables.size(), 1U);
+    EXPECT_EQ(s.tables[0].rows.size(), 3U);
+    ASSERT_EQ(s.charts.size(), 2U);
+    ASSERT_EQ(s.charts[0].series.size(), 3U);
+    EXPECT_EQ(s.charts[0].series[2].label, "lqg");
+  }
+  const Section& step = must(find_section(doc, "Simulation on the plant: step"));
+  const vcnc::DriveSimulation& lqg_step = o.simulations[4];
+  EXPECT_EQ(step.charts[0].series[2].y.back(), lqg_step.samples.back().load_velocity);
+  EXPECT_EQ(step.tables[0].rows[2][1], num(100.0 * lqg_step.metrics.overshoot, 4));
 }
 
 TEST(ComparisonReport, AFailedStructureIsARowWithItsReason) {

@@ -60,6 +60,9 @@ struct ComparisonReportOptions {
   std::string source;                  ///< the plant's name or file, for the subtitle
   std::size_t frequency_points = 400;  ///< log grid of the frequency charts, >= 16
   std::size_t time_points = 1200;      ///< samples of each step response, >= 16
+  /// Runs of the compared designs on the plant with its nonlinearities (vcnc::simulate_drive), any
+  /// structures and tests: one section per test with every structure's run overlaid.
+  std::vector<vcnc::DriveSimulation> simulations{};
 };
 
 /// The structure comparison of C7.15 (`servotwin tune compare --report`):
@@ -70,6 +73,8 @@ struct ComparisonReportOptions {
 ///    closed-loop |ωl/Tl| of every structure beside the uncontrolled plant's;
 ///  - "Time responses (linear)": the load velocity after a unit setpoint step and after a unit
 ///    load-torque step, and the torque command of the setpoint step, every structure in one chart;
+///  - per test in options.simulations, "Simulation on the plant: <test>": a metrics table (plant
+///    and linear part) and the controlled variable and torque of every structure overlaid;
 ///  - "Notes": each design's notes.
 /// core::InputError (field "comparison") when no structure has a design, and as tuning_report()
 /// for the point counts.
