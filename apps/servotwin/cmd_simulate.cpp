@@ -92,7 +92,7 @@ void print_summary(const vcnc::DriveSimulation& sim, const std::string& plant_so
   fmt::print("{} test, {} controller on {} (ts = {:.4g} s, {} samples, {:.4g} s); controlled variable: {} {}\n",
              vcnc::to_string(sim.test), tuning::to_string(sim.structure), plant_source, sim.ts, sim.samples.size(),
              sim.samples.back().t, sim.load_side ? "load" : "motor",
-             sim.structure == tuning::Structure::kPiP ? "position" : "velocity");
+             tuning::has_position_loop(sim.structure) ? "position" : "velocity");
   print_metrics("plant", sim.metrics, sim.test);
   print_metrics("linear", sim.linear_metrics, sim.test);
   for (const std::string& n : sim.notes) fmt::print("note: {}\n", n);

@@ -80,7 +80,6 @@ std::string margin(double v, const char* unit) {
 
 /// The pole-placement part of the summary: advice, admissible range, ω* and the gains.
 void print_cascade(const tuning::TuneResult& r, double hz) {
-  const tuning::NormalizedPlant& p = r.plant;
   const tuning::Controller& c = r.controller;
   fmt::print("advice: {}\n", r.advice.verdict);
   fmt::print("admissible omega*: [{:.4g}, {:.4g}] omega_z = [{:.4g}, {:.4g}] Hz (upper end: {})\n", r.range.omega_min,
@@ -91,20 +90,23 @@ void print_cascade(const tuning::TuneResult& r, double hz) {
   fmt::print("gains (model units): Kp = {:.6g}, Ki = {:.6g}", g.kp, g.ki);
   if (g.kd != 0.0) fmt::print(", Kd = {:.6g}, tau = {:.4g} s", g.kd, g.tau);
   fmt::print(", setpoint weight wp = {}\n", g.wp);
-  if (c.kpp_physical && c.position) {
-    fmt::print("position loop: Kpp = {:.6g} 1/s (no-overshoot limit {:.6g}{}); load-position bandwidth {:.4g} Hz, "
-               "||phi_l/T_l|| = {:.3g}\n",
-               *c.kpp_physical, c.position->kpp_nominal * p.omega_z,
-               c.position->kpp_rs ? fmt::format(", robust-stability limit {:.6g}", *c.position->kpp_rs * p.omega_z) : "",
-               c.position->bandwidth_load * hz, c.position->j2);
-  }
+}
+
+/// The P position loop of pi+p and lqg+p.
+void print_position_loop(const tuning::Controller& c, double hz) {
+  if (!c.kpp_physical || !c.position) return;
+  fmt::print("position loop: Kpp = {:.6g} 1/s (no-overshoot limit {:.6g}{}); load-position bandwidth {:.4g} Hz, "
+             "||phi_l/T_l|| = {:.3g}\n",
+             *c.kpp_physical, c.position->kpp_nominal * c.plant.omega_z,
+             c.position->kpp_rs ? fmt::format(", robust-stability limit {:.6g}", *c.position->kpp_rs * c.plant.omega_z) : "",
+             c.position->bandwidth_load * hz, c.position->j2);
 }
 
 /// The LQG part of the summary: kbw, kff and the compensator's stability.
-void print_lqg(const tuning::FullOrderSummary& f, const tuning::PlantScales& scales) {
-  fmt::print("structure lqg (C7.13, {} states): kbw = {:.4g} ({}), feedforward kff = {:.4g} normalized = {:.4g} "
-             "torque per velocity ({})\n",
-             f.compensator.states(), f.weights.kbw, f.kbw_source, f.weights.feedforward,
+void print_lqg(tuning::Structure structure, const tuning::FullOrderSummary& f, const tuning::PlantScales& scales) {
+  fmt::print("structure {}: LQG velocity loop (C7.13, {} states): kbw = {:.4g} ({}), feedforward kff = {:.4g} "
+             "normalized = {:.4g} torque per velocity ({})\n",
+             tuning::to_string(structure), f.compensator.states(), f.weights.kbw, f.kbw_source, f.weights.feedforward,
              f.weights.feedforward * scales.motor_inertia * scales.omega_z, f.feedforward_source);
   fmt::print("compensator: {}\n", f.controller_stable ? "stable" : "UNSTABLE (stable only inside the closed loop)");
 }
@@ -118,10 +120,11 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
              source, hz, p.r, p.zeta_z, p.zeta_p, p.a, p.motor_inertia,
              p.higher_modes.empty() ? "" : fmt::format(", {} higher mode(s)", p.higher_modes.size()));
   if (c.full_order) {
-    print_lqg(*c.full_order, c.plant);
+    print_lqg(c.structure, *c.full_order, c.plant);
   } else {
     print_cascade(r, hz);
   }
+  print_position_loop(c, hz);
   const tuning::LoopIndices& i = c.predicted;
   fmt::print("predicted (with the known HF dynamics): {}\n", i.closed_loop_stable ? "stable" : "UNSTABLE");
   fmt::print("  bandwidth: motor {:.4g} Hz, load {}\n", i.bandwidth_motor * hz,
@@ -222,9 +225,9 @@ void register_tune(CLI::App& app, Action& selected) {
                   "Plant: a fitted model (servotwin.plant-model/1 from `servotwin fit`), a plant description "
                   "(servotwin.plant/1) or a flexible preset name");
   cmd->add_option("--structure", a->structure,
-                  "pi, pid (virtual inertia, C7.5), pi+p (P position loop over the PI) or lqg (full-order velocity "
-                  "LQG, C7.13)")
-      ->check(CLI::IsMember({"pi", "pid", "pi+p", "lqg"}))
+                  "pi, pid (virtual inertia, C7.5), pi+p (P position loop over the PI), lqg (full-order velocity "
+                  "LQG, C7.13) or lqg+p (P position loop over the LQG)")
+      ->check(CLI::IsMember({"pi", "pid", "pi+p", "lqg", "lqg+p"}))
       ->capture_default_str();
   cmd->add_option("--zeta-star", a->zeta_star, "Damping of the assigned closed-loop pole pair")->capture_default_str();
   cmd->add_option("--omega-star", a->omega_star,

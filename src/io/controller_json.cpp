@@ -38,7 +38,7 @@ bool agree(double given, double expected) {
   return std::abs(given - expected) <= kRelTol * std::max(std::abs(given), std::abs(expected));
 }
 
-std::string loop_name(Structure s) { return s == Structure::kPiP ? "position" : "velocity"; }
+std::string loop_name(Structure s) { return tuning::has_position_loop(s) ? "position" : "velocity"; }
 
 // ---------------------------------------------------------------- writer
 
@@ -157,9 +157,12 @@ json robustness_json(const tuning::RobustnessSummary& r) {
           {"rp_tracking", put(r.rp_tracking, "rp_tracking")}};
 }
 
-json position_json(const std::optional<tuning::PositionSummary>& p, double omega_z) {
+json position_json(const tuning::Controller& c, double omega_z) {
+  const std::optional<tuning::PositionSummary>& p = c.position;
   if (!p) return nullptr;
-  return {{"kpp_nominal", finite(p->kpp_nominal, "position.kpp_nominal")},
+  return {{"kpp", finite(*c.kpp_physical, "position.kpp")},
+          {"kpp_normalized", finite(*c.kpp_normalized, "position.kpp_normalized")},
+          {"kpp_nominal", finite(p->kpp_nominal, "position.kpp_nominal")},
           {"kpp_rs", optional_finite(p->kpp_rs, "position.kpp_rs")},
           {"kpp_rp_exact", optional_finite(p->kpp_rp_exact, "position.kpp_rp_exact")},
           {"bandwidth_load", finite(p->bandwidth_load, "position.bandwidth_load")},
@@ -466,16 +469,30 @@ LoopIndices read_predicted(const Section& s, double omega_z) {
   return p;
 }
 
-/// The position-loop section: null for the velocity structures, an object for pi+p.
-std::optional<tuning::PositionSummary> read_position(const Section& root, Structure structure, double omega_z) {
+/// The position-loop section: null for the velocity structures, an object for pi+p and lqg+p. Its
+/// "kpp"/"kpp_normalized" carry the position gain (required for lqg+p, whose gains are null; for
+/// pi+p optional, as files before lqg+p lack them, and equal to the gains' when present).
+void read_position(const Section& root, tuning::Controller& c) {
+  const bool wanted = tuning::has_position_loop(c.structure);
+  const std::string name = to_string(c.structure);
   const bool present = !root.raw("position").is_null();
-  if (present != (structure == Structure::kPiP))
-    root.fail("position", structure == Structure::kPiP ? "a \"pi+p\" controller needs its position-loop section"
-                                                       : "only a \"pi+p\" controller has a position-loop section (expected null)");
-  if (!present) return std::nullopt;
+  if (present != wanted)
+    root.fail("position", wanted ? "a \"" + name + "\" controller needs its position-loop section"
+                                 : "only pi+p and lqg+p controllers have a position-loop section (expected null)");
+  if (!present) return;
   const Section s = root.section("position");
-  s.object.allow_only({"kpp_nominal", "kpp_rs", "kpp_rp_exact", "bandwidth_load", "bandwidth_load_hz", "j2",
-                       "peak_load_tracking"});
+  s.object.allow_only({"kpp", "kpp_normalized", "kpp_nominal", "kpp_rs", "kpp_rp_exact", "bandwidth_load",
+                       "bandwidth_load_hz", "j2", "peak_load_tracking"});
+  const double omega_z = c.plant.omega_z;
+  if (c.structure == Structure::kLqgP || s.value.contains("kpp")) {
+    const double kpp = s.positive("kpp", "a position gain [1/s]");
+    const double kpp_n = s.positive("kpp_normalized", "a normalized position gain");
+    check_scaled(s, "kpp", kpp, kpp_n * omega_z, "Kpp = Kpp_n·ωz");
+    if (c.kpp_physical && !agree(*c.kpp_physical, kpp))
+      s.fail("kpp", "is " + show(kpp) + " but gains.kpp is " + show(*c.kpp_physical));
+    c.kpp_physical = kpp;
+    c.kpp_normalized = kpp_n;
+  }
   tuning::PositionSummary p;
   p.kpp_nominal = s.positive("kpp_nominal", "a position gain");
   for (const char* key : {"kpp_rs", "kpp_rp_exact"}) {
@@ -487,7 +504,7 @@ std::optional<tuning::PositionSummary> read_position(const Section& root, Struct
   check_derived(s, "bandwidth_load_hz", "bandwidth_load", p.bandwidth_load, omega_z / kTwoPi, "× ωz/2π");
   p.j2 = s.non_negative("j2", "a peak gain");
   p.peak_load_tracking = s.non_negative("peak_load_tracking", "a peak gain");
-  return p;
+  c.position = p;
 }
 
 tuning::RobustnessSummary read_robustness(const Section& s) {
@@ -587,8 +604,8 @@ std::optional<tuning::FullOrderSummary> read_lqg(const Section& root, Structure 
   const bool present = root.value.contains("lqg") && !root.raw("lqg").is_null();  // absent before lqg existed
   const bool wanted = tuning::is_full_order(structure);
   if (present != wanted)
-    root.fail("lqg", wanted ? "an \"lqg\" controller needs its compensator section"
-                            : "only an \"lqg\" controller has a compensator section (expected null)");
+    root.fail("lqg", wanted ? "an \"" + to_string(structure) + "\" controller needs its compensator section"
+                            : "only lqg and lqg+p controllers have a compensator section (expected null)");
   if (!present) return std::nullopt;
   const Section s = root.section("lqg");
   s.object.allow_only({"kbw", "kbw_source", "feedforward", "feedforward_source", "q_load_velocity", "q_integral",
@@ -631,14 +648,14 @@ std::vector<std::string> read_notes(const Section& root) {
 }  // namespace
 
 json controller_to_json(const tuning::Controller& c, std::string_view plant_source) {
-  const bool position = c.structure == Structure::kPiP;
+  const bool position = tuning::has_position_loop(c.structure);
   if (position != c.kpp_physical.has_value() || position != c.kpp_normalized.has_value())
-    throw std::invalid_argument("controller_to_json: a position gain kpp belongs to exactly the \"pi+p\" controllers");
+    throw std::invalid_argument("controller_to_json: a position gain kpp belongs to exactly the pi+p and lqg+p controllers");
   if (position != c.position.has_value())
-    throw std::invalid_argument("controller_to_json: the position-loop summary belongs to exactly the \"pi+p\" controllers");
+    throw std::invalid_argument("controller_to_json: the position-loop summary belongs to exactly the pi+p and lqg+p controllers");
   const bool full_order = tuning::is_full_order(c.structure);
   if (full_order != c.full_order.has_value())
-    throw std::invalid_argument("controller_to_json: the compensator section belongs to exactly the \"lqg\" controllers");
+    throw std::invalid_argument("controller_to_json: the compensator section belongs to exactly the lqg and lqg+p controllers");
   const double wz = finite(c.plant.omega_z, "plant.omega_z");
   const tuning::PlantScales& p = c.plant;
   const core::StateSpace ss = tuning::controller_state_space(c);
@@ -681,7 +698,7 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
             {"omega_star_source", d.omega_star_source}}},
           {"predicted", predicted_json(c.predicted, wz)},
           {"robustness", robustness_json(c.robustness)},
-          {"position", position_json(c.position, wz)},
+          {"position", position_json(c, wz)},
           {"lqg", lqg_json(c.full_order)},
           {"notes", c.notes}};
 }
@@ -697,7 +714,8 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
 
   const std::string structure = root.object.string("structure");
   const auto parsed = tuning::structure_from_string(structure);
-  if (!parsed) root.fail("structure", "expected \"pi\", \"pid\", \"pi+p\" or \"lqg\", got \"" + structure + "\"");
+  if (!parsed)
+    root.fail("structure", "expected \"pi\", \"pid\", \"pi+p\", \"lqg\" or \"lqg+p\", got \"" + structure + "\"");
   c.structure = *parsed;
   const std::string loop = root.object.string("loop");
   if (loop != "velocity" && loop != "position")
@@ -711,7 +729,8 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
   std::vector<double> check_omegas = continuous_check_frequencies(c.plant.omega_z, c.physical);
   if (tuning::is_full_order(c.structure)) {
     for (const char* key : {"gains", "normalized"}) {
-      if (!root.raw(key).is_null()) root.fail(key, "expected null for an \"lqg\" controller (its law is the compensator)");
+      if (!root.raw(key).is_null())
+        root.fail(key, "expected null for an \"" + structure + "\" controller (its law is the compensator)");
     }
     c.full_order = read_lqg(root, c.structure);
     read_state_space(root, tuning::controller_state_space(c), check_omegas);
@@ -732,7 +751,7 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
   c.design = read_design(root.section("design"), c.plant.omega_z, c.structure);
   c.predicted = read_predicted(root.section("predicted"), c.plant.omega_z);
   c.robustness = read_robustness(root.section("robustness"));
-  c.position = read_position(root, c.structure, c.plant.omega_z);
+  read_position(root, c);
   c.notes = read_notes(root);
   return out;
 }

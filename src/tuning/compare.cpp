@@ -15,9 +15,9 @@ std::vector<StructureComparison> compare_structures(const fit::PlantModel& model
   std::vector<StructureComparison> out;
   std::optional<core::InputError> first_failure;
   for (const Structure s : structures) {
-    if (s == Structure::kPiP)
-      throw core::InputError(core::at_field("structures"),
-                             "expected velocity-loop structures (pi, pid, lqg): pi+p closes the position loop");
+    if (has_position_loop(s))
+      throw core::InputError(core::at_field("structures"), "expected velocity-loop structures (pi, pid, lqg): " +
+                                                               to_string(s) + " closes the position loop");
     StructureComparison entry;
     entry.structure = s;
     TuneOptions o = options;

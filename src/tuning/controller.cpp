@@ -19,14 +19,22 @@ std::string to_string(Structure structure) {
       return "pi+p";
     case Structure::kLqg:
       return "lqg";
+    case Structure::kLqgP:
+      return "lqg+p";
   }
   return "pi";
 }
 
-bool is_full_order(Structure structure) noexcept { return structure == Structure::kLqg; }
+bool is_full_order(Structure structure) noexcept {
+  return structure == Structure::kLqg || structure == Structure::kLqgP;
+}
+
+bool has_position_loop(Structure structure) noexcept {
+  return structure == Structure::kPiP || structure == Structure::kLqgP;
+}
 
 std::optional<Structure> structure_from_string(const std::string& name) {
-  for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP, Structure::kLqg}) {
+  for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP, Structure::kLqg, Structure::kLqgP}) {
     if (to_string(s) == name) return s;
   }
   return std::nullopt;

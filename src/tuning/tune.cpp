@@ -129,7 +129,7 @@ struct SpecCheck {
   /// with a margin for the scan grid's resolution: the bisections of kbw and kff end on the
   /// boundary, and the final test on the fine grid must still pass there.
   [[nodiscard]] bool robust(const VelocityLoop& loop) const {
-    if (options.structure != Structure::kLqg) return robustness(loop, *w2, options.ms, scan_robustness_options()).rp_ok;
+    if (!is_full_order(options.structure)) return robustness(loop, *w2, options.ms, scan_robustness_options()).rp_ok;
     constexpr double kScanGridMargin = 1e-3;
     return robust_tracking(loop, *w2, options.mt, scan_robustness_options()).value < 1.0 - kScanGridMargin;
   }
@@ -178,7 +178,7 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Eva
       at = c.omega_star;
     }
   }
-  const bool lqg = o.structure == Structure::kLqg;
+  const bool lqg = is_full_order(o.structure);
   const char* parameter = lqg ? "kbw" : "omega*";
   if (!std::isfinite(best_s)) {
     throw InputError(at_field("--structure"),
@@ -228,12 +228,12 @@ void add_position_loop(Controller& c, const VelocityLoop& loop, const std::optio
                        const NormalizedPlant& plant) {
   // With higher modes the load side is that of the first mode's two-mass realization.
   std::optional<VelocityLoop> first_mode;
-  if (!loop.has_load()) first_mode.emplace(plant, c.normalized, true, false);
+  if (!loop.has_load()) first_mode.emplace(plant, normalized_controller(c), true, false);
   const VelocityLoop& base = first_mode ? *first_mode : loop;
   if (!base.has_load()) {
     throw InputError(at_field("--structure"),
-                     "pi+p needs the load side of a two-mass realization, and this plant has none (its friction "
-                     "terms would be negative); tune the velocity loop with --structure pi");
+                     to_string(c.structure) + " needs the load side of a two-mass realization, and this plant has "
+                     "none (its friction terms would be negative); tune the velocity loop alone");
   }
   if (!plant.higher_modes.empty()) {
     c.notes.push_back("the position loop is designed on the first mode's two-mass realization (higher modes left out)");
@@ -436,7 +436,9 @@ void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& c
                                   "reach (saturation opens the loop)",
                                   pole_list(d.controller_poles)));
   }
-  if (check.w2) add_robustness(c, VelocityLoop(plant, tf), *check.w2, options);
+  const VelocityLoop loop(plant, tf);
+  if (check.w2) add_robustness(c, loop, *check.w2, options);
+  if (options.structure == Structure::kLqgP) add_position_loop(c, loop, check.w2, plant);
 }
 
 /// The cascade path of tune() (pi, pid, pi+p): ω*, the gains, their analysis and robustness.
@@ -511,7 +513,7 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   c.plant = scales(plant);
   c.design.ms = options.ms;
   c.design.mt = options.mt;
-  if (options.structure == Structure::kLqg) {
+  if (is_full_order(options.structure)) {
     tune_lqg(result, options, check);
   } else {
     tune_cascade(result, options, check);

@@ -35,7 +35,7 @@ void check_settings(const DriveSimulationSettings& s) {
     fail("settling_band", "a fraction in (0, 1)");
 }
 
-bool is_position_loop(const tuning::Controller& c) { return c.structure == tuning::Structure::kPiP; }
+bool is_position_loop(const tuning::Controller& c) { return tuning::has_position_loop(c.structure); }
 
 /// The measured output must be a motor-side signal: the cascade feeds back the motor.
 void check_plant(const machine::PlantConfig& plant, const tuning::Controller& controller, DriveTest test) {
@@ -48,7 +48,7 @@ void check_plant(const machine::PlantConfig& plant, const tuning::Controller& co
   if (test == DriveTest::kLoadStep && !chain)
     fail("model", "a mass chain for the load-step test: a transfer-function plant has no load-torque input");
   if (is_position_loop(controller) && !controller.kpp_physical)
-    fail("controller.kpp_physical", "the position gain of a pi+p controller");
+    fail("controller.kpp_physical", "the position gain of a " + tuning::to_string(controller.structure) + " controller");
 }
 
 /// Turns the plant's measurement into the motor velocity and position the controller reads.
@@ -297,7 +297,7 @@ std::optional<DriveTest> drive_test_from_string(std::string_view text) noexcept 
 }
 
 ControlledVariable controlled_variable(const DriveSimulation& simulation) noexcept {
-  return {simulation.structure == tuning::Structure::kPiP, simulation.load_side};
+  return {tuning::has_position_loop(simulation.structure), simulation.load_side};
 }
 
 machine::PlantConfig linear_part(const machine::PlantConfig& plant) {

@@ -48,7 +48,7 @@ TEST_F(Cli, TuneLqgAndSimulateIt) {
   // friction: the integral state balances the same 0.5 + 3.6 = 4.1 N m as the PI above.
   const Result t = run("tune table-5.1 --structure lqg -o lqg.json --report lqg.html");
   ASSERT_EQ(t.status, 0) << t.err;
-  EXPECT_NE(t.out.find("structure lqg (C7.13, 5 states): kbw = "), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("structure lqg: LQG velocity loop (C7.13, 5 states): kbw = "), std::string::npos) << t.out;
   EXPECT_NE(t.out.find("compensator: "), std::string::npos) << t.out;
   EXPECT_NE(t.out.find("verified by simulation"), std::string::npos) << t.out;
   EXPECT_NE(slurp(path("lqg.html")).find("LQG design (C7.13"), std::string::npos);
@@ -60,6 +60,25 @@ TEST_F(Cli, TuneLqgAndSimulateIt) {
   ASSERT_EQ(cells.size(), 14U);
   EXPECT_NEAR(std::stod(cells[3]), 4.1, 0.02);
   EXPECT_NEAR(std::stod(cells[5]), 1.0, 0.005);
+}
+
+TEST_F(Cli, TuneLqgPlusPAndSimulateAPositionStep) {
+  // C7.13's cascade alternative: a P position loop over the LQG velocity loop. The position step on
+  // table-5.1: the motor reaches the target (integral action in the velocity loop; the load sticks
+  // short of it on its stiction, as with pi+p in the study), and the file carries Kpp.
+  const Result t = run("tune table-5.1 --structure lqg+p -o lqgp.json");
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("structure lqg+p: LQG velocity loop"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("position loop: Kpp = "), std::string::npos) << t.out;
+  const std::string json = slurp(path("lqgp.json"));
+  EXPECT_NE(json.find("\"loop\": \"position\""), std::string::npos);
+  EXPECT_NE(json.find("\"kpp_normalized\""), std::string::npos);
+  const Result r = run("simulate --controller lqgp.json --duration 60 -o pos.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("controlled variable: load position"), std::string::npos) << r.out;
+  const auto cells = last_row(slurp(path("pos.csv")));
+  ASSERT_EQ(cells.size(), 14U);
+  EXPECT_NEAR(std::stod(cells[6]), 1.0, 0.01);  // motor position at the target
 }
 
 TEST_F(Cli, SimulateLoadStepWithATorqueLimit) {

@@ -586,7 +586,9 @@ TEST_F(ControllerJsonErrors, SamplePeriodAndPrewarp) {
 }
 
 TEST_F(ControllerJsonErrors, StructureAndLoop) {
-  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"pi\", \"pid\", \"pi+p\" or \"lqg\"");
+  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"pi+p\", \"lqg\" or \"lqg+p\"");
+  expect(with([](auto& c) { c["position"]["kpp"] = 1.0; c["position"]["kpp_normalized"] = 1.0; }, Structure::kPiP),
+         "position.kpp", "de-normalized");
   expect(with([](auto& c) { c["structure"] = "lqg"; }), "gains", "expected null for an \"lqg\" controller");
   expect(with([](auto& c) { c["loop"] = "position"; }), "loop", "velocity loop");
   expect(with([](auto& c) { c["loop"] = "velocity"; }, Structure::kPiP), "loop", "position loop");
@@ -602,6 +604,33 @@ TEST_F(ControllerJsonErrors, StructureAndLoop) {
   expect(with([](auto& c) { c["structure"] = "pi"; }), "gains.kd", "only \"pid\" has a derivative");
   expect(with([](auto& c) { c["gains"]["tau"] = 0.0; }), "gains.tau", "derivative filter time constant > 0");
   expect(with([](auto& c) { c["gains"]["wd"] = 1.5; }), "gains.wd", "[0, 1]");
+}
+
+TEST(ControllerJsonRoundTrip, LqgPlusPCarriesItsPositionGainInThePositionSection) {
+  fit::PlantModel model;
+  model.rigid = fit::RigidKind::kIntegrator;
+  model.gain = 250.0;
+  const double wz = kTwoPi * 40.0;
+  model.modes = {{{wz, 0.01}, {3.0 * wz, 3.0 * 0.01}}};
+  tuning::TuneOptions o;
+  o.structure = Structure::kLqgP;
+  o.ts = kTs;
+  const Controller c = tuning::tune(model, o).controller;
+  const nlohmann::json j = controller_to_json(c, "two_mass.json");
+  EXPECT_EQ(j["loop"], "position");
+  EXPECT_TRUE(j["gains"].is_null());
+  EXPECT_EQ(j["position"]["kpp"].get<double>(), *c.kpp_physical);
+  const LoadedController back = parse_controller_json(j.dump(), "lqgp.json");
+  expect_round_trip(c, back.controller);
+  nlohmann::json edited = j;
+  edited["position"].erase("kpp");
+  EXPECT_EQ(error_of(edited.dump()).field, "position.kpp");
+  edited = j;
+  edited["position"]["kpp"] = 2.0 * j["position"]["kpp"].get<double>();
+  EXPECT_EQ(error_of(edited.dump()).field, "position.kpp");
+  edited = j;
+  edited["loop"] = "velocity";
+  EXPECT_EQ(error_of(edited.dump()).field, "loop");
 }
 
 TEST_F(ControllerJsonErrors, LqgDocuments) {
@@ -625,7 +654,7 @@ TEST_F(ControllerJsonErrors, LqgDocuments) {
          "velocity_reference");
   expect(edited([](auto& c) { c["design"]["omega_star"] = 0.5; }), "design.omega_star", "expected null");
   expect(edited([](auto& c) { c["gains"] = c["state_space"]; }), "gains", "expected null");
-  expect(with([](auto& c) { c["lqg"] = {{"kbw", 1.0}}; }), "lqg", "only an \"lqg\" controller");
+  expect(with([](auto& c) { c["lqg"] = {{"kbw", 1.0}}; }), "lqg", "only lqg and lqg+p controllers");
 }
 
 TEST_F(ControllerJsonErrors, PlantDesignAndDerivedMembers) {

@@ -219,6 +219,36 @@ TEST(TuneLqg, ADelayRaisesTheKalmanMeasurementNoise) {
   EXPECT_THROW((void)tune(bench, o), core::InputError);
 }
 
+TEST(TuneLqg, LqgPlusPClosesANoOvershootPositionLoopOverTheLqg) {
+  // C7.13's cascade alternative: the velocity loop is the lqg design, Kpp the largest without
+  // overshoot of the load position. Reference: φl/φ* = Kpp Gl/(s + Kpp Gm) with Gm, Gl = ωm/ω*,
+  // ωl/ω* of the velocity loop, composed here on a dense grid.
+  TuneOptions o = lqg_options();
+  const TuneResult v = tune(model(3.0, 0.01), o);
+  o.structure = Structure::kLqgP;
+  const TuneResult p = tune(model(3.0, 0.01), o);
+  const Controller& c = p.controller;
+  ASSERT_TRUE(c.full_order.has_value());
+  ASSERT_TRUE(c.kpp_normalized.has_value());
+  ASSERT_TRUE(c.position.has_value());
+  EXPECT_EQ(c.full_order->weights.kbw, v.controller.full_order->weights.kbw);  // the same velocity loop
+  EXPECT_NEAR(*c.kpp_physical, *c.kpp_normalized * c.plant.omega_z, 1e-12 * *c.kpp_physical);
+  const VelocityLoop loop(p.plant, normalized_controller(c));
+  const double kpp = *c.kpp_normalized;
+  const auto load_position = [&](double w, double gain) {
+    const std::complex<double> jw(0.0, w);
+    return gain * loop.load_tracking(w) / (jw + gain * loop.motor_tracking(w));
+  };
+  double peak = 0.0, peak_above = 0.0;
+  for (const double w : core::log_space(1e-3, 1e2, 20000)) {
+    peak = std::max(peak, std::abs(load_position(w, kpp)));
+    peak_above = std::max(peak_above, std::abs(load_position(w, 1.05 * kpp)));
+  }
+  EXPECT_LE(peak, 1.0 + 1e-6);
+  EXPECT_NEAR(c.position->peak_load_tracking, peak, 1e-5);
+  EXPECT_GT(peak_above, 1.0 + 1e-6);  // the largest gain: 5 % more overshoots
+}
+
 TEST(TuneLqg, BadOptionsAreInputErrors) {
   TuneOptions o = lqg_options();
   o.kbw = -1.0;

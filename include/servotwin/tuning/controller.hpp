@@ -9,6 +9,8 @@
 ///   pid   the same plus kd s/(τ s + 1) on the measurement (wd = 0: no torque kick on steps)
 ///   pi+p  a P position loop ω* = kpp (φ* − φ) over the PI velocity loop
 ///   lqg   the full-order velocity LQG compensator of C7.13 (inputs [ω*, ωm], 5 states)
+///   lqg+p a P position loop over the LQG velocity loop (C7.13's more robust alternative to the
+///         full position LQG)
 
 #include <optional>
 #include <string>
@@ -23,12 +25,15 @@
 namespace servotwin::tuning {
 
 /// Controller structure offered by the tuner.
-enum class Structure { kPi, kPid, kPiP, kLqg };
+enum class Structure { kPi, kPid, kPiP, kLqg, kLqgP };
 
-/// A structure whose controller is a general state space (no PID gains): lqg.
+/// A structure whose velocity controller is a general state space (no PID gains): lqg, lqg+p.
 [[nodiscard]] bool is_full_order(Structure structure) noexcept;
 
-/// "pi", "pid", "pi+p", "lqg".
+/// A structure with a P position loop over its velocity loop: pi+p, lqg+p.
+[[nodiscard]] bool has_position_loop(Structure structure) noexcept;
+
+/// "pi", "pid", "pi+p", "lqg", "lqg+p".
 [[nodiscard]] std::string to_string(Structure structure);
 /// Inverse of to_string; std::nullopt for an unknown name.
 [[nodiscard]] std::optional<Structure> structure_from_string(const std::string& name);
@@ -86,13 +91,13 @@ struct Controller {
   PidGains normalized;                  ///< velocity-loop gains, normalized (kd = tau = 0 for PI; all 0 for lqg)
   PidGains physical;                    ///< the same in the model's units (to_physical)
   std::optional<FullOrderSummary> full_order;  ///< lqg only: the compensator (the gains are then unused)
-  std::optional<double> kpp_normalized;  ///< pi+p: position gain, normalized
-  std::optional<double> kpp_physical;    ///< pi+p: position gain [1/s]
+  std::optional<double> kpp_normalized;  ///< pi+p, lqg+p: position gain, normalized
+  std::optional<double> kpp_physical;    ///< pi+p, lqg+p: position gain [1/s]
   PlantScales plant;
   DesignParameters design;
   LoopIndices predicted;                ///< velocity-loop indices, normalized units
   RobustnessSummary robustness;
-  std::optional<PositionSummary> position;           ///< pi+p only
+  std::optional<PositionSummary> position;           ///< pi+p, lqg+p only
   std::optional<core::DiscreteStateSpace> discrete;  ///< the velocity controller at the drive's period
   std::optional<double> prewarp_rad_s;               ///< Tustin prewarp frequency (physical)
   std::vector<std::string> notes;       ///< warnings and facts a user must see
