@@ -726,16 +726,14 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
   root.expect_string("feedback", "motor");
 
   c.plant = read_plant(root.section("plant"), out.plant_source);
-  std::vector<double> check_omegas = continuous_check_frequencies(c.plant.omega_z, c.physical);
   if (tuning::is_full_order(c.structure)) {
     for (const char* key : {"gains", "normalized"}) {
       if (!root.raw(key).is_null())
         root.fail(key, "expected null for an \"" + structure + "\" controller (its law is the compensator)");
     }
-    c.full_order = read_lqg(root, c.structure);
-    read_state_space(root, tuning::controller_state_space(c), check_omegas);
-  } else {
-    (void)read_lqg(root, c.structure);
+  }
+  c.full_order = read_lqg(root, c.structure);
+  if (!c.full_order) {
     const Section gains = root.section("gains");
     const GainsRead physical = read_gains(gains, c.structure);
     const GainsRead normalized = read_gains(root.section("normalized"), c.structure);
@@ -744,9 +742,8 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
     c.normalized = normalized.gains;
     c.kpp_physical = physical.kpp;
     c.kpp_normalized = normalized.kpp;
-    check_omegas = continuous_check_frequencies(c.plant.omega_z, c.physical);
-    read_state_space(root, tuning::controller_state_space(c.physical), check_omegas);
   }
+  read_state_space(root, tuning::controller_state_space(c), continuous_check_frequencies(c.plant.omega_z, c.physical));
   c.discrete = read_discrete(root, c, c.prewarp_rad_s);
   c.design = read_design(root.section("design"), c.plant.omega_z, c.structure);
   c.predicted = read_predicted(root.section("predicted"), c.plant.omega_z);

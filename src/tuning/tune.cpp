@@ -299,14 +299,14 @@ struct LqgDesigner {
 };
 
 /// The first mode's two-mass realization with friction: the LQG's design model.
-FrictionTwoMass lqg_design_model(const NormalizedPlant& plant) {
+FrictionTwoMass lqg_design_model(const NormalizedPlant& plant, Structure structure) {
   NormalizedPlant first = plant;
   first.higher_modes.clear();
   const std::optional<FrictionTwoMass> m = physical_parameters_with_friction(first);
   if (!m) {
     throw InputError(at_field("--structure"),
-                     "lqg needs a two-mass realization with non-negative friction, and this plant has none (its "
-                     "friction terms would be negative); use --structure pi or pid");
+                     to_string(structure) + " needs a two-mass realization with non-negative friction, and this plant "
+                     "has none (its friction terms would be negative); use --structure pi or pid");
   }
   return *m;
 }
@@ -317,30 +317,41 @@ std::vector<double> kbw_candidates() {
   return k;
 }
 
-/// The automatic feedforward at one kbw and what limited it.
+/// The automatic feedforward at one kbw, what limited it, and the spec of the design with it.
 struct Feedforward {
   double kff = 0.0;
   std::string source;
+  TuneResult::Candidate candidate;  ///< check() at (kbw, kff)
 };
 
 /// The largest kff in [0, kFeedforwardCap] keeping the spec (C7.13: the tracking peak <= Mt):
 /// doubling to the first failure, then `bisections` halvings. 0 when the loop misses the spec
 /// without it.
 Feedforward automatic_feedforward(const LqgDesigner& lqg, const SpecCheck& check, double kbw, int bisections) {
-  const auto feasible = [&](double kff) { return check(kbw, lqg.loop(lqg.design(kbw, kff))).feasible; };
-  if (!feasible(0.0)) return {0.0, "none: the loop misses the spec already without feedforward"};
-  double lo = 0.0, hi = 0.125;
-  while (hi < kFeedforwardCap && feasible(hi)) {
-    lo = hi;
-    hi *= 2.0;
+  const auto evaluate = [&](double kff) { return check(kbw, lqg.loop(lqg.design(kbw, kff))); };
+  Feedforward best{0.0, "none: the loop misses the spec already without feedforward", evaluate(0.0)};
+  if (!best.candidate.feasible) return best;
+  // Keeps the largest feasible kff with its candidate; returns whether `kff` was feasible.
+  const auto try_kff = [&](double kff) {
+    TuneResult::Candidate c = evaluate(kff);
+    const bool feasible = c.feasible;
+    if (feasible) best = {kff, "", std::move(c)};
+    return feasible;
+  };
+  double hi = 0.125;
+  while (hi < kFeedforwardCap && try_kff(hi)) hi *= 2.0;
+  if (hi >= kFeedforwardCap && try_kff(hi)) {
+    best.source = fmt::format("capped at {:g}: the spec never binds", kFeedforwardCap);
+    return best;
   }
-  if (hi >= kFeedforwardCap && feasible(hi)) return {hi, fmt::format("capped at {:g}: the spec never binds", kFeedforwardCap)};
+  double lo = best.kff;
   for (int it = 0; it < bisections; ++it) {
     const double mid = 0.5 * (lo + hi);
-    (feasible(mid) ? lo : hi) = mid;
+    (try_kff(mid) ? lo : hi) = mid;
   }
-  return {lo, check.w2 ? "largest keeping the tracking peak <= Mt and robust tracking"
-                       : "largest keeping the tracking peak <= Mt"};
+  best.source = check.w2 ? "largest keeping the tracking peak <= Mt and robust tracking"
+                         : "largest keeping the tracking peak <= Mt";
+  return best;
 }
 
 /// The kbw giving the largest load bandwidth within the spec: each candidate is evaluated with its
@@ -353,8 +364,8 @@ std::optional<double> automatic_kbw(const LqgDesigner& lqg, const SpecCheck& che
                                     const std::optional<double>& given_kff, std::vector<TuneResult::Candidate>& scan) {
   constexpr int kRankingBisections = 12;
   const auto evaluate = [&](double kbw) {
-    const double kff = given_kff ? *given_kff : automatic_feedforward(lqg, check, kbw, kRankingBisections).kff;
-    return check(kbw, lqg.loop(lqg.design(kbw, kff)));
+    if (given_kff) return check(kbw, lqg.loop(lqg.design(kbw, *given_kff)));
+    return automatic_feedforward(lqg, check, kbw, kRankingBisections).candidate;
   };
   scan.clear();
   for (double kbw : kbw_candidates()) scan.push_back(evaluate(kbw));
@@ -402,7 +413,7 @@ std::string pole_list(const std::vector<std::complex<double>>& poles) {
 /// The LQG path of tune(): kbw and kff, the compensator, its analysis and robustness.
 void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
   const NormalizedPlant& plant = result.plant;
-  const FrictionTwoMass model = lqg_design_model(plant);
+  const FrictionTwoMass model = lqg_design_model(plant, options.structure);
   Controller& c = result.controller;
   FullOrderSummary f;
   f.weights = options.lqg;

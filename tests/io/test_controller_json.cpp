@@ -325,20 +325,23 @@ TEST(ControllerJsonRoundTrip, ControllersFromTheTuner) {
   }
 }
 
-/// An LQG from the tuner (r = 3, 40 Hz antiresonance, Im = 4 g·m², 8 kHz), with W2 so that the
-/// robust-tracking number is filled.
-Controller lqg_controller() {
+/// A full-order controller from the tuner (r = 3, 40 Hz antiresonance, Im = 4 g·m², 8 kHz); lqg
+/// with W2 so that the robust-tracking number is filled.
+Controller full_order_controller(Structure structure) {
   fit::PlantModel model;
   model.rigid = fit::RigidKind::kIntegrator;
   model.gain = 250.0;
   const double wz = kTwoPi * 40.0;
   model.modes = {{{wz, 0.01}, {3.0 * wz, 3.0 * 0.01}}};
   tuning::TuneOptions o;
-  o.structure = Structure::kLqg;
+  o.structure = structure;
   o.ts = kTs;
-  o.w2 = core::TransferFunction(core::Polynomial{1.0 / (3.0 * wz), 0.1}, core::Polynomial{1.0 / (3.0 * wz), 1.0});
+  if (structure == Structure::kLqg)
+    o.w2 = core::TransferFunction(core::Polynomial{1.0 / (3.0 * wz), 0.1}, core::Polynomial{1.0 / (3.0 * wz), 1.0});
   return tuning::tune(model, o).controller;
 }
+
+Controller lqg_controller() { return full_order_controller(Structure::kLqg); }
 
 TEST(ControllerJsonRoundTrip, LqgFromTheTuner) {
   const Controller c = lqg_controller();
@@ -607,15 +610,7 @@ TEST_F(ControllerJsonErrors, StructureAndLoop) {
 }
 
 TEST(ControllerJsonRoundTrip, LqgPlusPCarriesItsPositionGainInThePositionSection) {
-  fit::PlantModel model;
-  model.rigid = fit::RigidKind::kIntegrator;
-  model.gain = 250.0;
-  const double wz = kTwoPi * 40.0;
-  model.modes = {{{wz, 0.01}, {3.0 * wz, 3.0 * 0.01}}};
-  tuning::TuneOptions o;
-  o.structure = Structure::kLqgP;
-  o.ts = kTs;
-  const Controller c = tuning::tune(model, o).controller;
+  const Controller c = full_order_controller(Structure::kLqgP);
   const nlohmann::json j = controller_to_json(c, "two_mass.json");
   EXPECT_EQ(j["loop"], "position");
   EXPECT_TRUE(j["gains"].is_null());
