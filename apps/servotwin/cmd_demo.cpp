@@ -30,6 +30,7 @@ struct DemoArgs {
   std::string machine = "fadal-pid";
   std::uint64_t seed = 1;
   std::size_t ga_generations = 500;
+  bool refine = true;
   std::string out_dir, report;
 };
 
@@ -81,28 +82,47 @@ void print_identification(const machine::MachineConfig& machine, const std::vect
   }
 }
 
-void print_contouring(const std::vector<std::pair<std::string, vcnc::ContouringRun>>& runs) {
+void print_refinement(const std::vector<vcnc::AxisIdentification>& refined, double ms) {
+  fmt::print("   output-error refinement of the exact models (the simulated tracking error fitted to the capture), "
+             "{:.0f} ms:\n", ms);
+  for (const auto& m : refined) {
+    if (!m.refinement) continue;
+    fmt::print("   axis {}: refined poles    {}; fit nrmse {:.4f} -> {:.4f} ({} iterations)\n", m.axis,
+               roots_text(rapid::AxisModel(m.coefficients(), m.ts).poles()), m.solver_fit->nrmse, m.fit->nrmse,
+               m.refinement->iterations);
+  }
+}
+
+using Runs = std::vector<std::pair<std::string, vcnc::ContouringRun>>;
+
+void print_contour_row(const std::string& name, const char* models, const vcnc::ContouringRun& run) {
+  const vcnc::PredictionScore* s = vcnc::overall_score(run.comparison, "contour");
+  double max_pred = 0.0, max_act = 0.0;
+  for (std::size_t k = run.comparison.first; k < run.comparison.first + run.comparison.count; ++k) {
+    max_pred = std::max(max_pred, std::abs(run.prediction.contour_error[k]));
+    max_act = std::max(max_act, std::abs(run.comparison.contour_error[k]));
+  }
+  fmt::print("   {:<8} {:<8} {:>12.2f} / {:>7.2f} um ({:+5.1f} %) {:>12.2f} / {:>7.2f} um\n", name, models,
+             1000.0 * s->metrics.rms_predicted, 1000.0 * s->metrics.rms_measured,
+             100.0 * (s->metrics.rms_predicted / s->metrics.rms_measured - 1.0), 1000.0 * max_pred, 1000.0 * max_act);
+}
+
+void print_contouring(const Runs& runs, const Runs& refined_runs) {
   fmt::print("5. contouring at 200 mm/s (F12000) with the machine's 2000 mm/s^2 (thesis 3.4.1): predicted by the "
              "identified models vs run on the virtual machine\n");
-  fmt::print("   {:<8} {:>32} {:>28}\n", "toolpath", "contour error rms pred / actual", "max pred / actual");
-  for (const auto& [name, run] : runs) {
-    const vcnc::PredictionScore* s = vcnc::overall_score(run.comparison, "contour");
-    double max_pred = 0.0, max_act = 0.0;
-    for (std::size_t k = run.comparison.first; k < run.comparison.first + run.comparison.count; ++k) {
-      max_pred = std::max(max_pred, std::abs(run.prediction.contour_error[k]));
-      max_act = std::max(max_act, std::abs(run.comparison.contour_error[k]));
-    }
-    fmt::print("   {:<8} {:>12.2f} / {:>7.2f} um ({:+5.1f} %) {:>12.2f} / {:>7.2f} um\n", name,
-               1000.0 * s->metrics.rms_predicted, 1000.0 * s->metrics.rms_measured,
-               100.0 * (s->metrics.rms_predicted / s->metrics.rms_measured - 1.0), 1000.0 * max_pred, 1000.0 * max_act);
+  fmt::print("   {:<8} {:<8} {:>32} {:>28}\n", "toolpath", "models", "contour error rms pred / actual",
+             "max pred / actual");
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    print_contour_row(runs[i].first, "exact", runs[i].second);
+    if (i < refined_runs.size()) print_contour_row(refined_runs[i].first, "refined", refined_runs[i].second);
   }
 }
 
 /// The demo's report: the identification report of every axis, then each toolpath's prediction
 /// beside the machine's run, after a section with the comparison tables.
 report::Document demo_report(const machine::MachineConfig& machine, const std::vector<vcnc::AxisIdentification>& models,
-                             const std::vector<vcnc::NamedCapture>& captures,
-                             const std::vector<std::pair<std::string, vcnc::ContouringRun>>& runs) {
+                             const std::vector<vcnc::NamedCapture>& captures, const Runs& runs,
+                             const Runs& refined_runs) {
   report::Document doc = report::identification_report(models, captures, {});
   doc.title = "servotwin demo: " + machine.name;
   doc.subtitle = "the rapid-identification loop on a virtual machine: " + machine.description;
@@ -115,17 +135,21 @@ report::Document demo_report(const machine::MachineConfig& machine, const std::v
     const auto axis = std::find_if(machine.axes.begin(), machine.axes.end(), [&](const auto& c) { return c.name == m.axis; });
     if (axis == machine.axes.end()) continue;
     poles.rows.push_back({m.axis, roots_text(machine::equivalent_closed_loop(*axis, machine.ts).poles),
-                          roots_text(rapid::AxisModel(m.solution.coefficients, m.ts).poles())});
+                          roots_text(rapid::AxisModel(m.coefficients(), m.ts).poles())});
   }
   overview.tables.push_back(std::move(poles));
   report::Table contour;
   contour.title = "Contouring at 200 mm/s: contour error predicted vs run on the virtual machine [um]";
-  contour.header = {"toolpath", "rms predicted", "rms actual", "difference"};
-  for (const auto& [name, run] : runs) {
+  contour.header = {"toolpath", "models", "rms predicted", "rms actual", "difference"};
+  const auto add_row = [&](const std::string& name, const char* which, const vcnc::ContouringRun& run) {
     const vcnc::PredictionScore* s = vcnc::overall_score(run.comparison, "contour");
-    contour.rows.push_back({name, fmt::format("{:.2f}", 1000.0 * s->metrics.rms_predicted),
+    contour.rows.push_back({name, which, fmt::format("{:.2f}", 1000.0 * s->metrics.rms_predicted),
                             fmt::format("{:.2f}", 1000.0 * s->metrics.rms_measured),
                             fmt::format("{:+.1f} %", 100.0 * (s->metrics.rms_predicted / s->metrics.rms_measured - 1.0))});
+  };
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    add_row(runs[i].first, "exact", runs[i].second);
+    if (i < refined_runs.size()) add_row(refined_runs[i].first, "exact + output-error refinement", refined_runs[i].second);
   }
   overview.tables.push_back(std::move(contour));
   doc.sections.insert(doc.sections.begin(), std::move(overview));
@@ -163,16 +187,28 @@ int run(const DemoArgs& a, const GlobalOptions& global) {
     }
   }
   print_identification(machine, models, ga, identify_ms);
+  std::vector<vcnc::AxisIdentification> refined;
+  if (a.refine) {
+    const auto refine_start = std::chrono::steady_clock::now();
+    refined = models;
+    for (auto& m : refined) vcnc::refine_identification(m, captures);
+    print_refinement(refined, elapsed_ms(refine_start));
+  }
 
   motion::ContourProgramOptions toolpath;
   toolpath.center = vcnc::machine_start(machine);
   const std::vector<vcnc::AxisModelSpec> specs = vcnc::model_specs(models);
-  std::vector<std::pair<std::string, vcnc::ContouringRun>> runs;
+  Runs runs, refined_runs;
   std::vector<motion::Program> programs{motion::make_circle_program(toolpath), motion::make_diamond_program(toolpath)};
   for (const auto& program : programs) runs.emplace_back(program.name, vcnc::contouring_run(machine, specs, program));
-  print_contouring(runs);
+  if (!refined.empty()) {
+    const std::vector<vcnc::AxisModelSpec> refined_specs = vcnc::model_specs(refined);
+    for (const auto& program : programs)
+      refined_runs.emplace_back(program.name, vcnc::contouring_run(machine, refined_specs, program));
+  }
+  print_contouring(runs, refined_runs);
   fmt::print("\nwhole loop in {:.0f} ms.\n", elapsed_ms(start));
-  if (report_file) write_report(demo_report(machine, models, captures, runs), *report_file, global);
+  if (report_file) write_report(demo_report(machine, models, captures, runs, refined_runs), *report_file, global);
 
   if (!a.out_dir.empty()) {
     const std::filesystem::path dir(a.out_dir);
@@ -186,13 +222,17 @@ int run(const DemoArgs& a, const GlobalOptions& global) {
       write_file(dir / fmt::format("model_{}.json", m.axis), global,
                  [&](std::ostream& os) { os << io::axis_model_to_json(m).dump(2) << '\n'; });
     }
+    for (const auto& m : refined) {
+      write_file(dir / fmt::format("model_{}_refined.json", m.axis), global,
+                 [&](std::ostream& os) { os << io::axis_model_to_json(m).dump(2) << '\n'; });
+    }
     for (std::size_t i = 0; i < programs.size(); ++i) {
       const auto& [name, run] = runs[i];
       write_file(dir / (name + ".nc"), global, [&](std::ostream& os) { os << motion::write_iso(programs[i]); });
       write_file(dir / (name + "_prediction.csv"), global,
                  [&](std::ostream& os) { io::write_prediction_csv(os, run.prediction, &run.comparison); });
     }
-    fmt::print("wrote {}: identification.nc, capture.csv, machine.json, model_<axis>.json, circle.nc, diamond.nc and "
+    fmt::print("wrote {}: identification.nc, capture.csv, machine.json, model_<axis>[_refined].json, circle.nc, diamond.nc and "
                "<toolpath>_prediction.csv\n",
                a.out_dir);
   } else {
@@ -212,6 +252,8 @@ void register_demo(CLI::App& app, Action& selected) {
   cmd->add_option("--ga-generations", a->ga_generations,
                   "Generations of the thesis's genetic algorithm run for comparison (0: skip it)")
       ->capture_default_str();
+  cmd->add_flag("!--no-refine", a->refine,
+               "Skip the output-error refinement of the exact models (rows 'refined' of the contour table)");
   cmd->add_option("--out", a->out_dir, "Directory to keep the programs, capture, machine, models and predictions in");
   add_report_option(*cmd, a->report);
   set_examples(*cmd, "  servotwin demo\n  servotwin demo --machine fadal-ppi --out demo-run\n  servotwin demo --report demo.html\n");

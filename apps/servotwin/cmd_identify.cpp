@@ -26,6 +26,7 @@ struct IdentifyArgs {
   std::string shift = "auto";
   double trim_start_s = 0.0, trim_end_s = 0.0, deadband = 0.0;
   CLI::Option* deadband_opt = nullptr;
+  bool refine = false;
   std::string output, stats_output, report;
 };
 
@@ -92,6 +93,7 @@ int run(const IdentifyArgs& a, const GlobalOptions& global) {
   settings.regressors.trim_start = static_cast<std::size_t>(std::llround(a.trim_start_s / ts));
   settings.regressors.trim_end = static_cast<std::size_t>(std::llround(a.trim_end_s / ts));
   if (a.deadband_opt->count() > 0) settings.regressors.velocity_deadband = a.deadband;
+  settings.refine = a.refine;
 
   const std::vector<std::string> axes = axes_to_identify(a, captures, global);
   const auto report_file = open_report(a.report, global);
@@ -142,6 +144,9 @@ void register_identify(CLI::App& app, Action& selected) {
   cmd->add_option("--trim-end", a->trim_end_s, "Seconds dropped at the end of each capture")->capture_default_str();
   a->deadband_opt = cmd->add_option("--deadband", a->deadband,
                                     "Velocity deadband of the direction indicators [length/s] (default: from the data)");
+  cmd->add_flag("--refine", a->refine,
+               "Refine the solver's model by output error: the coefficients whose simulation follows the measured "
+               "position best, within the same bounds (slower: some 100 simulations)");
   add_capture_input_options(*cmd, a->reading);
   cmd->add_option("--validate", a->validate, "Validation captures: the model's simulated tracking error is scored on them")
       ->check(CLI::ExistingFile);
@@ -152,7 +157,8 @@ void register_identify(CLI::App& app, Action& selected) {
                "  servotwin identify capture.csv --axis x --method exact -o model.json --stats-out stats.json\n"
                "  servotwin identify DATA_EMPS.csv --map x_cmd=qg --map x_act=qm --scale 1000 --validate other.csv -o model.json\n"
                "  servotwin identify low.csv high.csv --method ga --seed 3 -o model_{axis}.json\n"
-               "  servotwin identify capture.csv --validate check.csv --report identification.html\n");
+               "  servotwin identify capture.csv --validate check.csv --report identification.html\n"
+               "  servotwin identify capture.csv --refine --validate check.csv -o model.json\n");
   cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });
 }
 

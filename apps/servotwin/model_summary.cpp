@@ -15,6 +15,16 @@ std::string root_text(const core::ModalInfo& m) {
   if (m.root.imag() != 0.0) return fmt::format("{:.2f} Hz, zeta {:.3f}", m.freq_hz, m.zeta);
   return fmt::format("{:.2f} Hz real{}", m.freq_hz, m.root.real() > 0.0 ? " (UNSTABLE)" : "");
 }
+/// The solver's model (before refinement) and what the output-error refinement made of it.
+void print_refinement(const vcnc::AxisIdentification& r) {
+  const auto& s = r.solution;
+  const auto& f = *r.refinement;
+  fmt::print("  solver's model: wn {:.3f} Hz, zeta {:.4f}, p {:.3f} Hz; {}\n", s.wn / kTwoPi, s.zeta, s.p / kTwoPi,
+             s.kkt_case.empty() ? "" : "case " + s.kkt_case);
+  fmt::print("  output-error refinement: fit nrmse {:.4f} -> {:.4f}, {} iterations, {} simulations, {:.1f} ms ({})\n",
+             r.solver_fit ? r.solver_fit->nrmse : std::nan(""), r.fit ? r.fit->nrmse : std::nan(""), f.iterations,
+             f.simulations, f.time_ms, f.stop_reason);
+}
 }  // namespace
 
 std::string roots_text(const std::vector<core::ModalInfo>& roots) {
@@ -30,18 +40,25 @@ void print_roots(const char* label, const std::vector<core::ModalInfo>& roots) {
 
 void print_model_summary(const vcnc::AxisIdentification& r) {
   const auto& s = r.solution;
-  const auto& c = s.coefficients;
+  const auto& c = r.coefficients();
   const rapid::AxisModel model(c, r.ts);
   fmt::print("axis {}: method {}, objective {:.6g}{} ({:.2f} ms){}\n", r.axis, rapid::method_name(s.method), s.objective,
              std::isfinite(s.lower_bound) && s.method == rapid::Method::Exact
                  ? fmt::format(", certified lower bound {:.6g}", s.lower_bound)
                  : std::string(),
              s.time_ms, s.feasible ? "" : "  [outside the bounds]");
+  if (r.refinement) print_refinement(r);
   fmt::print("  a1 = {:.6g}  a2 = {:.6g}  a3 = {:.6g}\n  b0 = {:.6g}  b1 = {:.6g}  b2 = {:.6g}\n  d0 = {:.6g}  d1 = {:.6g}\n",
              c.a1, c.a2, c.a3, c.b0, c.b1, c.b2, c.d0, c.d1);
-  fmt::print("  search: wn {:.3f} Hz, zeta {:.4f}, p {:.3f} Hz; {}\n", s.wn / kTwoPi, s.zeta, s.p / kTwoPi,
-             s.kkt_case.empty() ? "" : "case " + s.kkt_case);
-  for (const auto& a : s.active) fmt::print("  active bound {} (multiplier {:.4g})\n", a.name, a.multiplier);
+  if (r.refinement) {
+    const auto& f = *r.refinement;
+    fmt::print("  search: wn {:.3f} Hz, zeta {:.4f}, p {:.3f} Hz (refined)\n", f.wn / kTwoPi, f.zeta, f.p / kTwoPi);
+    for (const auto& a : f.active) fmt::print("  active bound {} (cost derivative {:.4g})\n", a.name, a.multiplier);
+  } else {
+    fmt::print("  search: wn {:.3f} Hz, zeta {:.4f}, p {:.3f} Hz; {}\n", s.wn / kTwoPi, s.zeta, s.p / kTwoPi,
+               s.kkt_case.empty() ? "" : "case " + s.kkt_case);
+    for (const auto& a : s.active) fmt::print("  active bound {} (multiplier {:.4g})\n", a.name, a.multiplier);
+  }
   print_roots("poles", model.poles());
   print_roots("zeros", model.zeros());
   fmt::print("  {}; tracking bandwidth {:.2f} Hz\n", model.is_stable() ? "stable" : "UNSTABLE", model.bandwidth_hz());
@@ -56,8 +73,10 @@ void print_model_summary(const vcnc::AxisIdentification& r) {
     fmt::print("  fit (simulated tracking error): rms {:.4g} of {:.4g} {}, nrmse {:.4f}\n", r.fit->rms_difference,
                r.fit->rms_measured, r.length_unit, r.fit->nrmse);
   if (r.validation)
-    fmt::print("  validation: rms {:.4g} of {:.4g} {}, nrmse {:.4f}\n", r.validation->rms_difference,
-               r.validation->rms_measured, r.length_unit, r.validation->nrmse);
+    fmt::print("  validation: rms {:.4g} of {:.4g} {}, nrmse {:.4f}{}\n", r.validation->rms_difference,
+               r.validation->rms_measured, r.length_unit, r.validation->nrmse,
+               r.solver_validation ? fmt::format(" (solver's model before refinement: {:.4f})", r.solver_validation->nrmse)
+                                   : std::string());
   for (const auto& w : s.warnings) fmt::print("  warning: {}\n", w);
 }
 

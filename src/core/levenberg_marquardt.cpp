@@ -11,7 +11,7 @@ namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
-/// λ beyond this multiple of max D² means the step is the (tiny) scaled gradient step and still
+/// λ beyond this (the damping then outweighs JᵀJ by 1e16) means the step is the (tiny) scaled gradient step and still
 /// fails: nothing more can be gained.
 constexpr double kLambdaLimit = 1e16;
 
@@ -189,8 +189,10 @@ LmResult levenberg_marquardt(const LmResidualFunction& residual_function, const 
   Eigen::VectorXd d = current.j.colwise().norm().transpose();
   for (Eigen::Index k = 0; k < n; ++k)
     if (!(d[k] > 0.0)) d[k] = 1.0;
-  const double d2_max = n > 0 ? d.cwiseAbs2().maxCoeff() : 1.0;
-  double lambda = options.initial_lambda * d2_max;
+  // D holds J's column norms, so lambda ||D h||^2 is commensurate with ||J h||^2 and lambda is
+  // dimensionless: multiplying it by max D^2 as well would make the damping depend on the units
+  // of the residuals (a fit in um would take other steps than the same fit in mm).
+  double lambda = options.initial_lambda;
   double nu = 2.0;
 
   result.status = LmStatus::kMaxIterations;
@@ -257,7 +259,7 @@ LmResult levenberg_marquardt(const LmResidualFunction& residual_function, const 
     if (options.record_history) result.history.push_back(record);
     lambda *= nu;
     nu *= 2.0;
-    if (lambda > kLambdaLimit * d.cwiseAbs2().maxCoeff()) {
+    if (lambda > kLambdaLimit) {
       result.status = LmStatus::kStalled;
       result.message = "no step reduces the cost even with very large damping";
       break;

@@ -139,12 +139,48 @@ LoadedStatistics load_statistics(const std::vector<std::string>& paths) {
   return total;
 }
 
+namespace {
+
+json coefficients_to_json(const rapid::ModelCoefficients& c) {
+  return {{"a1", c.a1}, {"a2", c.a2}, {"a3", c.a3}, {"b0", c.b0}, {"b1", c.b1}, {"b2", c.b2}, {"d0", c.d0}, {"d1", c.d1}};
+}
+
+json search_to_json(double wn, double zeta, double p) {
+  return {{"wn_hz", number_or_null(wn / kTwoPi)}, {"zeta", number_or_null(zeta)}, {"p_hz", number_or_null(p / kTwoPi)}};
+}
+
+json active_to_json(const std::vector<rapid::ActiveBound>& bounds) {
+  json active = json::array();
+  for (const auto& a : bounds) active.push_back({{"name", a.name}, {"multiplier", a.multiplier}});
+  return active;
+}
+
+/// The solver's model and what the output-error refinement did (the refined model is "model").
+json refinement_to_json(const vcnc::AxisIdentification& record) {
+  const rapid::Refinement& f = *record.refinement;
+  const rapid::Solution& s = record.solution;
+  json doc = {{"method", "output-error"},
+              {"solver_model", coefficients_to_json(s.coefficients)},
+              {"solver_search", search_to_json(s.wn, s.zeta, s.p)},
+              {"initial_cost", f.initial_cost},
+              {"cost", f.cost},
+              {"active_constraints", active_to_json(f.active)},
+              {"iterations", f.iterations},
+              {"simulations", f.simulations},
+              {"converged", f.converged},
+              {"stop_reason", f.stop_reason},
+              {"time_ms", f.time_ms}};
+  if (record.solver_fit) doc["solver_fit"] = fit_to_json(*record.solver_fit);
+  if (record.solver_validation) doc["solver_validation"] = fit_to_json(*record.solver_validation);
+  return doc;
+}
+
+}  // namespace
+
 json axis_model_to_json(const vcnc::AxisIdentification& record) {
   const rapid::Solution& s = record.solution;
-  const rapid::ModelCoefficients& c = s.coefficients;
+  const rapid::ModelCoefficients& c = record.coefficients();
   const rapid::AxisModel model(c, record.ts);
-  json active = json::array();
-  for (const auto& a : s.active) active.push_back({{"name", a.name}, {"multiplier", a.multiplier}});
   json solver = {{"method", rapid::method_name(s.method)}, {"seed", nullptr}, {"time_ms", s.time_ms}};
   if (s.method == rapid::Method::Ga) {
     solver["seed"] = s.seed;
@@ -153,18 +189,19 @@ json axis_model_to_json(const vcnc::AxisIdentification& record) {
       history.push_back({g.objective, g.p / kTwoPi, g.wn / kTwoPi, g.zeta});
     solver["history"] = {{"columns", {"objective", "p_hz", "wn_hz", "zeta"}}, {"rows", history}};
   }
-  const auto& th = s.theta;
+  const rapid::Vector8 th = record.refinement ? rapid::theta_from_coefficients(c) : s.theta;
+  const json search = record.refinement ? search_to_json(record.refinement->wn, record.refinement->zeta, record.refinement->p)
+                                        : search_to_json(s.wn, s.zeta, s.p);
   json doc = {
       {"format", kAxisModelFormat},
       {"axis", record.axis},
       {"ts", record.ts},
       {"length_unit", record.length_unit},
-      {"model",
-       {{"a1", c.a1}, {"a2", c.a2}, {"a3", c.a3}, {"b0", c.b0}, {"b1", c.b1}, {"b2", c.b2}, {"d0", c.d0}, {"d1", c.d1}}},
+      {"model", coefficients_to_json(c)},
       {"theta",
        {{"alpha_i", th(0)}, {"alpha_1", th(1)}, {"alpha_2", th(2)}, {"beta_0", th(3)}, {"beta_1", th(4)},
         {"beta_2", th(5)}, {"delta_pos", th(6)}, {"delta_neg", th(7)}}},
-      {"search", {{"wn_hz", number_or_null(s.wn / kTwoPi)}, {"zeta", number_or_null(s.zeta)}, {"p_hz", number_or_null(s.p / kTwoPi)}}},
+      {"search", search},
       {"poles", modal_list(model.poles())},
       {"zeros", modal_list(model.zeros())},
       {"stable", model.is_stable()},
@@ -177,7 +214,7 @@ json axis_model_to_json(const vcnc::AxisIdentification& record) {
         {"zeta_min", record.bounds.zeta_min},
         {"zeta_max", record.bounds.zeta_max}}},
       {"feasible", s.feasible},
-      {"active_constraints", active},
+      {"active_constraints", active_to_json(s.active)},
       {"kkt_case", s.kkt_case},
       {"objective", s.objective},
       {"lower_bound", number_or_null(s.lower_bound)},
@@ -194,6 +231,7 @@ json axis_model_to_json(const vcnc::AxisIdentification& record) {
     for (const auto& t : record.shift_trials) trials.push_back({{"shift", t.shift}, {"nrmse", t.nrmse}, {"stable", t.stable}});
     doc["shift_search"] = trials;
   }
+  if (record.refinement) doc["refinement"] = refinement_to_json(record);
   if (record.fit) doc["fit"] = fit_to_json(*record.fit);
   if (record.validation) doc["validation"] = fit_to_json(*record.validation);
   return doc;

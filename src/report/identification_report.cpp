@@ -392,7 +392,7 @@ Document identification_report(std::span<const vcnc::AxisIdentification> axes,
 
   doc.sections.push_back(captures_section(axes, used, axes.front().length_unit));
   for (const auto& id : axes) {
-    const rapid::AxisModel model(id.solution.coefficients, id.ts);
+    const rapid::AxisModel model(id.coefficients(), id.ts);
     doc.sections.push_back(model_section(id, model));
     doc.sections.push_back(frequency_section(id, model));
     doc.sections.push_back(simulation_section(id, model, used));

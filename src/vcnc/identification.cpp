@@ -157,6 +157,25 @@ std::vector<std::string> moving_axes(const std::vector<NamedCapture>& captures) 
   return names;
 }
 
+void refine_identification(AxisIdentification& result, const std::vector<NamedCapture>& captures,
+                           const rapid::RefineOptions& refine_options) {
+  rapid::RefineOptions options = refine_options;
+  if (!result.solution.feasible) {
+    result.solution.warnings.push_back("not refined: the solver's poles are outside the bounds (use --method exact)");
+    return;
+  }
+  std::vector<rapid::TrackingRecord> records;
+  for (const auto& c : captures) {
+    const core::AxisTrace& trace = require_axis(c, result.axis);
+    records.push_back({trace.cmd, trace.act});
+  }
+  options.command_shift = result.regressors.command_shift;
+  result.refinement = rapid::refine_output_error(result.solution.coefficients, result.ts, records, result.bounds, options);
+  result.solver_fit = result.fit;
+  result.fit = simulated_fit(rapid::AxisModel(result.coefficients(), result.ts), captures, result.axis,
+                             result.regressors.command_shift);
+}
+
 AxisIdentification identify_axis(const std::vector<NamedCapture>& captures, const std::vector<NamedCapture>& validation,
                                  const std::string& axis, const IdentificationSettings& settings) {
   if (captures.empty()) throw core::InputError("no captures to identify from");
@@ -183,9 +202,14 @@ AxisIdentification identify_axis(const std::vector<NamedCapture>& captures, cons
   } else {
     result = identify_with_shift(captures, axis, settings, bounds);
   }
+  if (settings.refine) refine_identification(result, captures, settings.refine_options);
   if (!validation.empty()) {
-    const rapid::AxisModel model(result.solution.coefficients, result.ts);
+    const rapid::AxisModel model(result.coefficients(), result.ts);
     result.validation = simulated_fit(model, validation, axis, result.regressors.command_shift);
+    if (result.refinement) {
+      result.solver_validation = simulated_fit(rapid::AxisModel(result.solution.coefficients, result.ts), validation, axis,
+                                               result.regressors.command_shift);
+    }
   }
   for (const auto& c : captures) result.sources.push_back(c.source);
   return result;

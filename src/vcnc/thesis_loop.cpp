@@ -29,7 +29,7 @@ std::vector<AxisIdentification> identify_axes(const std::vector<NamedCapture>& c
 std::vector<AxisModelSpec> model_specs(const std::vector<AxisIdentification>& identifications) {
   std::vector<AxisModelSpec> specs;
   for (const auto& id : identifications) {
-    specs.push_back({id.axis, rapid::AxisModel(id.solution.coefficients, id.ts), id.regressors.command_shift,
+    specs.push_back({id.axis, rapid::AxisModel(id.coefficients(), id.ts), id.regressors.command_shift,
                      "model of axis " + id.axis});
   }
   return specs;

@@ -25,6 +25,30 @@ class Identify : public Cli {
   [[nodiscard]] json read_json(const std::string& name) const { return json::parse(slurp(path(name))); }
 };
 
+TEST_F(Identify, RefineWritesTheRefinedModelWithTheSolversBeside) {
+  // Sliding-mode preset: the equation-error model simulates the tracking error with a 21 % residual,
+  // the refined one with about 7 % (docs/rapid-identification-study.md).
+  capture("smc", "fadal-smc", 7);
+  capture("smc_check", "fadal-smc", 11);
+  const auto r = run("identify smc.csv --axis x --refine --validate smc_check.csv -o model.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("output-error refinement: fit nrmse"));
+  EXPECT_THAT(r.out, HasSubstr("(solver's model before refinement:"));
+  const json m = read_json("model.json");
+  ASSERT_TRUE(m.contains("refinement"));
+  const json& f = m["refinement"];
+  EXPECT_EQ(f["method"], "output-error");
+  EXPECT_LT(f["cost"].get<double>(), f["initial_cost"].get<double>());
+  EXPECT_LT(m["fit"]["nrmse"].get<double>(), 0.10);
+  EXPECT_GT(f["solver_fit"]["nrmse"].get<double>(), 0.15);
+  EXPECT_LT(m["validation"]["nrmse"].get<double>(), 0.10);
+  EXPECT_GT(f["solver_validation"]["nrmse"].get<double>(), 0.15);
+  EXPECT_NE(m["model"]["a2"], f["solver_model"]["a2"]);
+  EXPECT_TRUE(m["stable"].get<bool>());
+  // predict simulates the refined model: its coefficients are "model".
+  ASSERT_EQ(run("model model.json").status, 0);
+}
+
 TEST_F(Identify, IssueCommandFormsProduceTheDocumentedFiles) {
   capture("capture");
   const auto r = run("identify capture.csv --axis x --method exact -o model.json --stats-out stats.json");

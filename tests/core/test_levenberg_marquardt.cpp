@@ -45,6 +45,28 @@ TEST(LevenbergMarquardt, RosenbrockReachesTheClosedFormMinimum) {
     }
 }
 
+TEST(LevenbergMarquardt, StepsDoNotDependOnTheUnitOfTheResiduals) {
+  // Residuals in another unit (x 1000, e.g. um instead of mm) are the same problem: every trial
+  // point, and so the iteration count and the history of gain ratios, must be the same.
+  const auto scaled = [](double unit) {
+    return [unit](const Eigen::VectorXd& p, Eigen::VectorXd& r, Eigen::MatrixXd* j) {
+      rosenbrock(p, r, j);
+      r *= unit;
+      if (j) *j *= unit;
+      return true;
+    };
+  };
+  const LmResult a = levenberg_marquardt(scaled(1.0), Eigen::Vector2d(-1.2, 1.0), 2);
+  const LmResult b = levenberg_marquardt(scaled(1000.0), Eigen::Vector2d(-1.2, 1.0), 2);
+  ASSERT_EQ(a.history.size(), b.history.size());
+  for (std::size_t i = 0; i < a.history.size(); ++i) {
+    EXPECT_EQ(a.history[i].accepted, b.history[i].accepted) << i;
+    EXPECT_NEAR(a.history[i].lambda, b.history[i].lambda, 1e-9 * a.history[i].lambda) << i;
+  }
+  EXPECT_NEAR(a.parameters[0], b.parameters[0], 1e-10);
+  EXPECT_NEAR(a.parameters[1], b.parameters[1], 1e-10);
+}
+
 TEST(LevenbergMarquardt, NumericJacobianGivesTheSameMinimum) {
   LmOptions o;
   o.numeric_jacobian = true;

@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <numbers>
+
 #include <filesystem>
 #include <fstream>
 
@@ -145,6 +147,45 @@ TEST(RapidJson, ModelFileRoundTripsTheCoefficients) {
   EXPECT_EQ(back.model.coefficients().a3, 146558.19);
   EXPECT_EQ(back.model.coefficients().d1, -428.0);
   EXPECT_EQ(back.method, "exact");
+}
+
+TEST(RapidJson, RefinedModelFileHoldsTheRefinedModelAndTheSolversBeside) {
+  servotwin::vcnc::AxisIdentification r;
+  r.axis = "x";
+  r.ts = 0.001;
+  r.bounds = rapid::default_bounds(r.ts);
+  r.solution.coefficients = {123.02, 40099.88, 146558.19, -0.08, 123.16, 40089.20, 478.0, -428.0};
+  r.solution.theta = rapid::theta_from_coefficients(r.solution.coefficients);
+  r.solution.method = rapid::Method::Exact;
+  rapid::Refinement f;
+  f.coefficients = {130.0, 41000.0, 150000.0, -0.05, 128.0, 41010.0, 470.0, -420.0};
+  f.p = 3.7;
+  f.wn = 200.0;
+  f.zeta = 0.3;
+  f.initial_cost = 2.0;
+  f.cost = 0.5;
+  f.iterations = 7;
+  f.simulations = 70;
+  f.converged = true;
+  f.stop_reason = "relative cost reduction below tolerance";
+  f.active = {{"zeta_min", 0.25}};
+  r.refinement = f;
+  r.solver_fit = rapid::FitMetrics{1.0, 0.9, 0.2, 0.3, 0.2};
+  r.fit = rapid::FitMetrics{1.0, 0.95, 0.1, 0.2, 0.1};
+  const nlohmann::json j = io::axis_model_to_json(r);
+  EXPECT_EQ(j["model"]["a2"], 41000.0);  // what predict simulates: the refined model
+  EXPECT_NEAR(j["search"]["wn_hz"].get<double>(), 200.0 / (2.0 * std::numbers::pi), 1e-12);
+  EXPECT_NEAR(j["theta"]["alpha_2"].get<double>(), 1.0 / 41000.0, 1e-18);
+  const auto& refinement = j["refinement"];
+  EXPECT_EQ(refinement["method"], "output-error");
+  EXPECT_EQ(refinement["solver_model"]["a2"], 40099.88);
+  EXPECT_EQ(refinement["iterations"], 7);
+  EXPECT_EQ(refinement["active_constraints"][0]["name"], "zeta_min");
+  EXPECT_EQ(refinement["solver_fit"]["nrmse"], 0.2);
+  EXPECT_EQ(j["fit"]["nrmse"], 0.1);
+  const io::LoadedAxisModel back = io::parse_axis_model_json(j.dump(), "m.json");
+  EXPECT_EQ(back.model.coefficients().a2, 41000.0);
+  EXPECT_EQ(back.model.coefficients().d1, -420.0);
 }
 
 TEST(RapidJson, ModelFileErrors) {

@@ -38,7 +38,7 @@ Outcome run_case(const machine::MachineConfig& machine, const vcnc::Identificati
   Outcome out;
   out.identification = vcnc::identify_axis({thesis_capture(machine, 7)}, {}, "x", settings);
   const int shift = out.identification.regressors.command_shift;
-  const rapid::AxisModel model(out.identification.solution.coefficients, machine.ts);
+  const rapid::AxisModel model(out.identification.coefficients(), machine.ts);
   out.frf_error = tracking_frf_error(model, machine.axes.front(), machine.ts, shift, 0.5, 30.0);
   out.prediction_same_kind = prediction_error_ratio(model, *thesis_capture(machine, 11).capture.find("x"), shift);
   out.prediction_high_set =
@@ -110,6 +110,66 @@ TEST_P(PresetIdentification, SearchedShiftPredictsAtLeastAsWellAsTheControllersP
 INSTANTIATE_TEST_SUITE_P(Presets, PresetIdentification,
                          ::testing::Values(Case{"fadal-ppi", 0.08, 0.10}, Case{"fadal-pid", 0.03, 0.10},
                                            Case{"fadal-smc", 0.05, 0.23}, Case{"ballscrew-zpetc", 0.01, 0.30}),
+                         [](const auto& param_info) {
+                           std::string n = param_info.param.machine;
+                           for (char& ch : n)
+                             if (ch == '-') ch = '_';
+                           return n;
+                         });
+
+/// With the output-error refinement (rapid/refine.hpp) on the identification data. The bound is
+/// the 10 %. The ZPETC loop's 3.5 um RMS error is of the order of its 1.25 um encoder
+/// quantum: against the encoder's reading the residual cannot fall below the quantization noise
+/// (q / sqrt(12) = 10.4 %), and against the true table position the loop's own reaction to the
+/// quantized feedback (which no model driven by the command can predict) remains: 14 % and
+/// 9.7-10.2 % are measured, bounded at 16 % and 11 %.
+struct RefinedCase {
+  const char* machine;
+  double to_reading;  // prediction error vs the encoder's reading, both other programs
+  double to_truth;    // vs the true table position
+};
+
+class RefinedIdentification : public ::testing::TestWithParam<RefinedCase> {};
+
+TEST_P(RefinedIdentification, PredictsTrackingOfOtherProgramsWithinTenPercent) {
+  const machine::MachineConfig machine = machine::preset(GetParam().machine);
+  vcnc::IdentificationSettings settings = searched_shift();
+  const Outcome exact = run_case(machine, settings);
+  settings.refine = true;
+  const Outcome o = run_case(machine, settings);
+  const auto& id = o.identification;
+  ASSERT_TRUE(id.refinement.has_value());
+  const rapid::Refinement& f = *id.refinement;
+  const int shift = id.regressors.command_shift;
+  const rapid::AxisModel model(id.coefficients(), machine.ts);
+  const core::AxisTrace other = *thesis_capture(machine, 11).capture.find("x");
+  const core::AxisTrace high = *thesis_capture(machine, 5, motion::IdentificationSet::High).capture.find("x");
+  const double truth_other = prediction_error_ratio_to_truth(model, machine, other, shift);
+  const double truth_high = prediction_error_ratio_to_truth(model, machine, high, shift);
+  std::printf("%s refined (shift %d): wn %.2f Hz zeta %.3f p %.2f Hz; fit nrmse %.4f -> %.4f in %d iterations, %d "
+              "simulations, %.0f ms (%s)\n",
+              machine.name.c_str(), shift, f.wn / kTwoPi, f.zeta, f.p / kTwoPi, id.solver_fit->nrmse, id.fit->nrmse,
+              f.iterations, f.simulations, f.time_ms, f.stop_reason.c_str());
+  std::printf("  FRF error 0.5-30 Hz %.4f (exact %.4f); prediction error vs reading: other seed %.4f, high set %.4f "
+              "(exact %.4f, %.4f); vs true position %.4f, %.4f\n",
+              o.frf_error, exact.frf_error, o.prediction_same_kind, o.prediction_high_set, exact.prediction_same_kind,
+              exact.prediction_high_set, truth_other, truth_high);
+  EXPECT_TRUE(model.is_stable());
+  EXPECT_LE(f.cost, f.initial_cost);
+  EXPECT_LT(id.fit->nrmse, id.solver_fit->nrmse);
+  // Better than the equation-error model on programs it was not fitted on.
+  EXPECT_LT(o.prediction_same_kind, exact.prediction_same_kind);
+  EXPECT_LT(o.prediction_high_set, exact.prediction_high_set);
+  EXPECT_LT(o.prediction_same_kind, GetParam().to_reading);
+  EXPECT_LT(o.prediction_high_set, GetParam().to_reading);
+  EXPECT_LT(truth_other, GetParam().to_truth);
+  EXPECT_LT(truth_high, GetParam().to_truth);
+}
+
+INSTANTIATE_TEST_SUITE_P(Presets, RefinedIdentification,
+                         ::testing::Values(RefinedCase{"fadal-ppi", 0.01, 0.01}, RefinedCase{"fadal-pid", 0.02, 0.02},
+                                           RefinedCase{"fadal-smc", 0.10, 0.10},
+                                           RefinedCase{"ballscrew-zpetc", 0.16, 0.11}),
                          [](const auto& param_info) {
                            std::string n = param_info.param.machine;
                            for (char& ch : n)
@@ -198,6 +258,24 @@ TEST(EmpsIdentification, BoundedModelIsStableAndPredictsOtherData) {
   EXPECT_LT(bounded.fit->nrmse, 0.05);
   EXPECT_LT(bounded.validation->nrmse, 0.10);
   EXPECT_LT(bounded_pulses.validation->nrmse, 0.25);
+
+  // Output-error refinement on measured data: it fits the identification half five times better,
+  // but predicts the second half worse than the equation-error model (structure, not noise: the
+  // measured axis is not exactly Eq. 3.3), which is why it is an option to be checked with
+  // --validate rather than the default.
+  exact.refine = true;
+  const auto refined = vcnc::identify_axis({first}, {second, pulses}, "x", exact);
+  const auto only_second = vcnc::identify_axis({first}, {second}, "x", exact);
+  std::printf("EMPS refined: wn %.3f Hz zeta %.4f p %.3f Hz; fit %.4f; second half %.4f (exact %.4f); both %.4f\n",
+              refined.refinement->wn / kTwoPi, refined.refinement->zeta, refined.refinement->p / kTwoPi,
+              refined.fit->nrmse, only_second.validation->nrmse, only_second.solver_validation->nrmse,
+              refined.validation->nrmse);
+  EXPECT_LT(refined.fit->nrmse, 0.25 * bounded.fit->nrmse);
+  EXPECT_TRUE(rapid::AxisModel(refined.coefficients(), data.ts).is_stable());
+  ASSERT_EQ(refined.refinement->active.size(), 1u);
+  EXPECT_EQ(refined.refinement->active.front().name, "p_min");
+  EXPECT_GT(only_second.validation->nrmse, only_second.solver_validation->nrmse);
+  EXPECT_LT(only_second.validation->nrmse, 0.15);
 }
 
 TEST(EmpsIdentification, SameModelInMetresAndMillimetres) {

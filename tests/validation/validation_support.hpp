@@ -10,6 +10,7 @@
 
 #include "servotwin/machine/closed_loop.hpp"
 #include "servotwin/machine/presets.hpp"
+#include "servotwin/machine/simulator.hpp"
 #include "servotwin/motion/identification_program.hpp"
 #include "servotwin/rapid/axis_model.hpp"
 #include "servotwin/vcnc/identification.hpp"
@@ -56,19 +57,39 @@ inline double tracking_frf_error(const rapid::AxisModel& model, const machine::A
   return worst;
 }
 
-/// RMS of (predicted - actual tracking error) / RMS of the actual tracking error on a capture.
-inline double prediction_error_ratio(const rapid::AxisModel& model, const core::AxisTrace& trace, int shift) {
+/// RMS of (predicted - actual tracking error) / RMS of the actual one, the actual error being
+/// command - `position`, the model simulated from the command and the capture's first reading.
+inline double error_ratio(const rapid::AxisModel& model, const core::AxisTrace& trace, const std::vector<double>& position,
+                          int shift) {
   rapid::ModelSimulationOptions options;
   options.command_shift = shift;
   options.initial_position = trace.act.front();
   const rapid::ModelResponse r = model.simulate(trace.cmd, options);
   double diff = 0.0, actual = 0.0;
   for (std::size_t k = 0; k < trace.cmd.size(); ++k) {
-    const double e = trace.cmd[k] - trace.act[k];
+    const double e = trace.cmd[k] - position[k];
     diff += (r.tracking_error[k] - e) * (r.tracking_error[k] - e);
     actual += e * e;
   }
   return std::sqrt(diff / actual);
+}
+
+/// RMS of (predicted - actual tracking error) / RMS of the actual tracking error on a capture.
+inline double prediction_error_ratio(const rapid::AxisModel& model, const core::AxisTrace& trace, int shift) {
+  return error_ratio(model, trace, trace.act, shift);
+}
+
+/// The same, against the machine's true tracking error (command - true table position, without
+/// the encoder's quantization): the capture is run again on the machine's first axis with the
+/// same noise stream and its states recorded (the run is deterministic, checked on `act`).
+inline double prediction_error_ratio_to_truth(const rapid::AxisModel& model, const machine::MachineConfig& machine,
+                                              const core::AxisTrace& trace, int shift) {
+  machine::SimulationOptions o;
+  o.record_states = true;
+  o.record_u = false;
+  const machine::AxisRun run = machine::simulate_axis(machine.axes.front(), machine.ts, trace.cmd, o, 0);
+  if (run.act != trace.act) return std::nan("");  // not the same run: the comparison would be meaningless
+  return error_ratio(model, trace, run.table, shift);
 }
 
 }  // namespace servotwin::validation

@@ -36,7 +36,7 @@ enum class LmCovarianceScale {
 
 struct LmOptions {
   int max_iterations = 200;          ///< iterations (accepted or rejected steps) before giving up
-  double initial_lambda = 1e-3;      ///< λ0 relative to max_j D_j² (Nielsen's τ; the catalog's example uses 1e-7)
+  double initial_lambda = 1e-3;      ///< λ0, dimensionless: D² already carries JᵀJ's scale (Nielsen's τ; the catalog's example uses 1e-7)
   double gradient_tolerance = 1e-10; ///< stop when max_j |g_j| / D_j ≤ this·‖r‖ over the free parameters (scaled first-order optimality)
   double step_tolerance = 1e-12;     ///< stop when ‖D h‖ ≤ this·(‖D p‖ + this)
   double cost_tolerance = 0.0;       ///< stop when ½‖r‖² ≤ this (exact-fit problems)

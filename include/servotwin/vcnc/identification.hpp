@@ -10,6 +10,7 @@
 
 #include "servotwin/core/capture.hpp"
 #include "servotwin/rapid/axis_model.hpp"
+#include "servotwin/rapid/refine.hpp"
 #include "servotwin/rapid/regression.hpp"
 #include "servotwin/rapid/solver.hpp"
 
@@ -40,6 +41,10 @@ struct IdentificationSettings {
   /// transport delay (negative shift). On the presets the fit on the identification data ranks
   /// the shifts exactly as the prediction of other programs does (docs/rapid-identification-study.md).
   std::optional<ShiftSearch> shift_search;
+  /// Refine the solver's model by output error (rapid/refine.hpp) on the identification captures,
+  /// with the chosen shift: the model that simulates the measured motion best within the bounds.
+  bool refine = false;
+  rapid::RefineOptions refine_options;  ///< command_shift is set from the identification
 };
 
 /// One shift tried by the search.
@@ -56,11 +61,24 @@ struct AxisIdentification {
   rapid::Solution solution;
   rapid::Bounds bounds;
   rapid::RegressorOptions regressors;
+  /// Output-error refinement, when asked: its coefficients are the model in use (coefficients()).
+  std::optional<rapid::Refinement> refinement;
+  /// With a refinement: the solver's model's fit, before refinement (`fit` is the refined one's).
+  std::optional<rapid::FitMetrics> solver_fit;
   std::optional<rapid::FitMetrics> fit;         ///< simulated tracking error on the identification data
   std::optional<rapid::FitMetrics> validation;  ///< on separate captures, when given
+  /// With a refinement and validation captures: the solver's model on them, so that a user can see
+  /// whether the refined model also predicts data it was not fitted on better (on the EMPS axis it
+  /// does not: docs/rapid-identification-study.md).
+  std::optional<rapid::FitMetrics> solver_validation;
   std::vector<ShiftTrial> shift_trials;         ///< when the shift was searched, every shift tried
   std::vector<std::string> sources;
   std::string length_unit = "mm";               ///< for people reading the file
+
+  /// The model in use: the refined coefficients when refined, else the solver's.
+  [[nodiscard]] const rapid::ModelCoefficients& coefficients() const noexcept {
+    return refinement ? refinement->coefficients : solution.coefficients;
+  }
 };
 
 /// Bounds with zero members replaced by the defaults of ts; validated.
@@ -81,6 +99,13 @@ rapid::FitMetrics simulated_fit(const rapid::AxisModel& model, const std::vector
 /// the axes an identification can say something about. A 3-axis capture of a one-axis program
 /// holds two axes at rest.
 std::vector<std::string> moving_axes(const std::vector<NamedCapture>& captures);
+
+/// Output-error refinement (rapid/refine.hpp) of an identification on its identification
+/// captures, with its shift: sets `refinement` and `solver_fit`, and `fit` to the refined model's
+/// (identify_axis does this when settings.refine). A solver's model outside the bounds (Ls) is not
+/// refined: a warning says so.
+void refine_identification(AxisIdentification& identification, const std::vector<NamedCapture>& captures,
+                           const rapid::RefineOptions& options = {});
 
 /// The whole identification of one axis. With a shift search, core::InputError when the range is
 /// inverted or wider than 64 samples.
