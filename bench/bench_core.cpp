@@ -13,6 +13,7 @@
 #include <cmath>
 #include <vector>
 
+#include "servotwin/core/model_reduction.hpp"
 #include "servotwin/core/state_space.hpp"
 
 namespace {
@@ -118,5 +119,29 @@ void BM_RootsTripleRoot(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_RootsTripleRoot)->Unit(benchmark::kMicrosecond);
+
+/// Balanced truncation of a 5-mode drive (10 states, lightly damped) to 4 states: the model
+/// reduction of a multi-mode plant or controller (C7.16), a design-time step. Target: < 1 ms.
+void BM_BalancedTruncation10To4States(benchmark::State& state) {
+  servotwin::core::StateSpace g;
+  const int modes = 5;
+  g.A = Eigen::MatrixXd::Zero(2 * modes, 2 * modes);
+  g.B = Eigen::MatrixXd::Zero(2 * modes, 1);
+  g.C = Eigen::MatrixXd::Zero(1, 2 * modes);
+  g.D = Eigen::MatrixXd::Zero(1, 1);
+  for (int i = 0; i < modes; ++i) {
+    const double w = std::pow(3.0, i), z = 0.02 + 0.01 * i;
+    g.A(2 * i, 2 * i + 1) = 1.0;
+    g.A(2 * i + 1, 2 * i) = -w * w;
+    g.A(2 * i + 1, 2 * i + 1) = -2.0 * z * w;
+    g.B(2 * i + 1, 0) = 1.0;
+    g.C(0, 2 * i) = w * w / (1.0 + i);
+  }
+  for (auto _ : state) {
+    auto r = servotwin::core::balanced_truncation(g, 4);
+    benchmark::DoNotOptimize(r.error_bound);
+  }
+}
+BENCHMARK(BM_BalancedTruncation10To4States)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

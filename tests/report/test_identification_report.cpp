@@ -229,6 +229,23 @@ TEST(IdentificationReport, SeveralAxesShareTheCaptureSection) {
   EXPECT_EQ(chart_count(doc), 1u + 2u * 5u);
 }
 
+TEST(IdentificationReport, RefinedModelIsTheOneShownWithTheSolversBeside) {
+  const Fixture& f = fixture();
+  vcnc::AxisIdentification refined = f.id;
+  vcnc::refine_identification(refined, f.captures);
+  ASSERT_TRUE(refined.refinement.has_value());
+  const Document doc = identification_report(refined, f.captures, f.validation);
+  const Section& model = doc.sections[1];
+  EXPECT_NE(model.text.find("refined by output error"), std::string::npos);
+  const Table& coefficients = table(model, "Coefficients");
+  EXPECT_NEAR(std::stod(coefficients.rows[1][1]), refined.coefficients().a2, 1e-7 * std::abs(refined.coefficients().a2));
+  EXPECT_NE(refined.coefficients().a2, refined.solution.coefficients.a2);
+  const Table& bounds = table(section(doc, "Axis x: frequency responses"), "Bounds");
+  EXPECT_EQ(bounds.header[3], "refined");
+  EXPECT_NEAR(std::stod(bounds.rows[1][3]), refined.refinement->wn / kTwoPi, 1e-4 * refined.refinement->wn / kTwoPi);
+  EXPECT_EQ(table(model, "Solver").rows[0][1], "exact");  // the solver's own table stays the solver's
+}
+
 TEST(IdentificationReport, UnstableModelIsReportedNotRefused) {
   Fixture f = fixture();
   f.id.solution.coefficients.a1 = -200.0;  // a pole far in the right half plane
