@@ -23,10 +23,10 @@ constexpr double kDifferenceStep = 1e-6;
 
 enum Index : std::size_t { kLogP, kLogWn, kZeta, kB0, kB1, kB2, kD0, kD1 };
 
-/// Length scale of the friction parameters: the RMS measured tracking error.
-struct Scales {
-  double error = 1.0;
-};
+/// a1, a2, a3 of the characteristic polynomial (s + p)(s^2 + 2 zeta wn s + wn^2).
+std::array<double, 3> characteristic(double p, double wn, double zeta) {
+  return {p + 2.0 * zeta * wn, wn * wn + 2.0 * zeta * wn * p, p * wn * wn};
+}
 
 void check_records(std::span<const TrackingRecord> records) {
   if (records.empty()) throw core::InputError({"", 0, 0, "records"}, "no captures to refine the model on");
@@ -77,20 +77,21 @@ double rms_tracking_error(std::span<const TrackingRecord> records) {
   return std::sqrt(sum / static_cast<double>(n));
 }
 
-ModelCoefficients coefficients_of(const std::array<double, kParameters>& q, const Scales& s) {
-  const double p = std::exp(q[kLogP]), wn = std::exp(q[kLogWn]), zeta = q[kZeta];
+/// Coefficients of the full parameter vector q; `error` is the length scale of the friction
+/// parameters (the RMS measured tracking error).
+ModelCoefficients coefficients_of(const std::array<double, kParameters>& q, double error) {
   ModelCoefficients c;
-  // (s + p)(s^2 + 2 zeta wn s + wn^2) = s^3 + a1 s^2 + a2 s + a3
-  c.a1 = p + 2.0 * zeta * wn;
-  c.a2 = wn * wn + 2.0 * zeta * wn * p;
-  c.a3 = p * wn * wn;
+  const auto [a1, a2, a3] = characteristic(std::exp(q[kLogP]), std::exp(q[kLogWn]), q[kZeta]);
+  c.a1 = a1;
+  c.a2 = a2;
+  c.a3 = a3;
   c.b0 = q[kB0];
   // b1, b2 relative to the current a1, a2: moving the poles moves the zeros with them, which
   // keeps the parameters nearly uncorrelated (with fixed scales b2 ~ a2 forms a long valley).
   c.b1 = q[kB1] * c.a1;
   c.b2 = q[kB2] * c.a2;
-  c.d0 = q[kD0] * c.a2 * s.error;  // friction as the static deflection it causes, d / a2
-  c.d1 = q[kD1] * c.a2 * s.error;
+  c.d0 = q[kD0] * c.a2 * error;  // friction as the static deflection it causes, d / a2
+  c.d1 = q[kD1] * c.a2 * error;
   return c;
 }
 
@@ -100,10 +101,10 @@ struct Layout {
   std::vector<std::size_t> free;
 };
 
-Layout layout_of(const ModelCoefficients& c, const PoleFactorization& f, const Scales& s) {
+Layout layout_of(const ModelCoefficients& c, const PoleFactorization& f, double error) {
   Layout l;
-  const double a1 = f.p + 2.0 * f.zeta * f.wn, a2 = f.wn * f.wn + 2.0 * f.zeta * f.wn * f.p;
-  l.start = {std::log(f.p), std::log(f.wn), f.zeta, c.b0, c.b1 / a1, c.b2 / a2, c.d0 / (a2 * s.error), c.d1 / (a2 * s.error)};
+  const std::array<double, 3> a = characteristic(f.p, f.wn, f.zeta);
+  l.start = {std::log(f.p), std::log(f.wn), f.zeta, c.b0, c.b1 / a[0], c.b2 / a[1], c.d0 / (a[1] * error), c.d1 / (a[1] * error)};
   const std::array<double, kParameters> raw = {f.p, f.wn, f.zeta, c.b0, c.b1, c.b2, c.d0, c.d1};
   for (std::size_t i = 0; i < kParameters; ++i)
     if (raw[i] != 0.0) l.free.push_back(i);
@@ -113,8 +114,8 @@ Layout layout_of(const ModelCoefficients& c, const PoleFactorization& f, const S
 /// Simulates the model of full parameters q on every record; residuals x_model - x.
 class Simulator {
  public:
-  Simulator(double ts, std::span<const TrackingRecord> records, int shift, const Scales& scales)
-      : ts_(ts), records_(records), shift_(shift), scales_(scales) {
+  Simulator(double ts, std::span<const TrackingRecord> records, int shift, double error)
+      : ts_(ts), records_(records), shift_(shift), error_(error) {
     for (const auto& r : records) samples_ += r.command.size();
   }
 
@@ -122,7 +123,7 @@ class Simulator {
 
   bool residuals(const std::array<double, kParameters>& q, Eigen::VectorXd& out) {
     ++simulations;
-    const ModelCoefficients c = coefficients_of(q, scales_);
+    const ModelCoefficients c = coefficients_of(q, error_);
     try {
       const AxisModel model(c, ts_);
       Eigen::Index row = 0;
@@ -145,7 +146,7 @@ class Simulator {
   double ts_;
   std::span<const TrackingRecord> records_;
   int shift_;
-  Scales scales_;
+  double error_;
   std::size_t samples_ = 0;
   ModelResponse response_;
 };
@@ -193,12 +194,11 @@ Refinement refine_output_error(const ModelCoefficients& start, double ts, std::s
   check_records(records);
   const PoleFactorization poles = feasible_factorization(start, bounds);
 
-  Scales scales;
   const double error = rms_tracking_error(records);
-  if (error > 0.0) scales.error = error;
+  const double friction_scale = error > 0.0 ? error : 1.0;  // length scale of the friction parameters
 
-  const Layout layout = layout_of(start, poles, scales);
-  Simulator simulator(ts, records, options.command_shift, scales);
+  const Layout layout = layout_of(start, poles, friction_scale);
+  Simulator simulator(ts, records, options.command_shift, friction_scale);
   auto full = [&](const Eigen::VectorXd& free) {
     std::array<double, kParameters> q = layout.start;
     for (std::size_t i = 0; i < layout.free.size(); ++i) q[layout.free[i]] = free[static_cast<Eigen::Index>(i)];
@@ -238,7 +238,7 @@ Refinement refine_output_error(const ModelCoefficients& start, double ts, std::s
 
   Refinement out;
   const std::array<double, kParameters> q = full(lm_result.parameters);
-  out.coefficients = coefficients_of(q, scales);
+  out.coefficients = coefficients_of(q, friction_scale);
   out.p = std::exp(q[kLogP]);
   out.wn = std::exp(q[kLogWn]);
   out.zeta = q[kZeta];

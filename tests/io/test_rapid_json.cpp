@@ -124,15 +124,20 @@ TEST(RapidJson, StatisticsErrorsNameTheField) {
   EXPECT_THAT(error_of(broken.dump()), HasSubstr("unsupported version"));
 }
 
-TEST(RapidJson, ModelFileRoundTripsTheCoefficients) {
+/// An exact identification with thesis Table 3.4's "Estimated" Y coefficients, 1 kHz.
+servotwin::vcnc::AxisIdentification table34_identification(const std::string& axis) {
   servotwin::vcnc::AxisIdentification r;
-  r.axis = "y";
+  r.axis = axis;
   r.ts = 0.001;
   r.bounds = rapid::default_bounds(r.ts);
-  // Thesis Table 3.4, "Estimated" Y column.
   r.solution.coefficients = {123.02, 40099.88, 146558.19, -0.08, 123.16, 40089.20, 478.0, -428.0};
   r.solution.theta = rapid::theta_from_coefficients(r.solution.coefficients);
   r.solution.method = rapid::Method::Exact;
+  return r;
+}
+
+TEST(RapidJson, ModelFileRoundTripsTheCoefficients) {
+  servotwin::vcnc::AxisIdentification r = table34_identification("y");
   r.fit = rapid::FitMetrics{1.0, 0.9, 0.1, 0.3, 0.1};
   const nlohmann::json j = io::axis_model_to_json(r);
   EXPECT_EQ(j["format"], "servotwin.axis-model/1");
@@ -150,13 +155,7 @@ TEST(RapidJson, ModelFileRoundTripsTheCoefficients) {
 }
 
 TEST(RapidJson, RefinedModelFileHoldsTheRefinedModelAndTheSolversBeside) {
-  servotwin::vcnc::AxisIdentification r;
-  r.axis = "x";
-  r.ts = 0.001;
-  r.bounds = rapid::default_bounds(r.ts);
-  r.solution.coefficients = {123.02, 40099.88, 146558.19, -0.08, 123.16, 40089.20, 478.0, -428.0};
-  r.solution.theta = rapid::theta_from_coefficients(r.solution.coefficients);
-  r.solution.method = rapid::Method::Exact;
+  servotwin::vcnc::AxisIdentification r = table34_identification("x");
   rapid::Refinement f;
   f.coefficients = {130.0, 41000.0, 150000.0, -0.05, 128.0, 41010.0, 470.0, -420.0};
   f.p = 3.7;

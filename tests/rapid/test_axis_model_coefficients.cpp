@@ -8,6 +8,7 @@
 
 #include "servotwin/core/error.hpp"
 #include "servotwin/rapid/axis_model.hpp"
+#include "test_axis_model_support.hpp"
 
 namespace servotwin::rapid {
 namespace {
@@ -40,15 +41,7 @@ TEST(AxisModelCoefficients, RoundTripIsExactToRounding) {
   };
   for (const ModelCoefficients& c : cases) {
     const ModelCoefficients back = coefficients_from_theta(theta_from_coefficients(c));
-    const double tol = 4.0 * std::numeric_limits<double>::epsilon();
-    EXPECT_NEAR(back.a1, c.a1, tol * std::abs(c.a1));
-    EXPECT_NEAR(back.a2, c.a2, tol * std::abs(c.a2));
-    EXPECT_NEAR(back.a3, c.a3, tol * std::abs(c.a3));
-    EXPECT_NEAR(back.b0, c.b0, tol * std::abs(c.b0));
-    EXPECT_NEAR(back.b1, c.b1, tol * std::abs(c.b1));
-    EXPECT_NEAR(back.b2, c.b2, tol * std::abs(c.b2));
-    EXPECT_NEAR(back.d0, c.d0, tol * std::abs(c.d0));
-    EXPECT_NEAR(back.d1, c.d1, tol * std::abs(c.d1));
+    test::expect_coefficients_near(back, c, 4.0 * std::numeric_limits<double>::epsilon());
   }
 }
 

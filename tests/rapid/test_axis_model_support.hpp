@@ -3,6 +3,8 @@
 // tools/reference/axis_model_reference.py (numpy/scipy). Every expected value read through these
 // helpers comes from that script.
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -87,6 +89,18 @@ inline std::vector<double> back_and_forth(double distance, double speed, double 
     rest(dwell);
   }
   return out;
+}
+
+/// Every coefficient of `actual` within `rel` of `expected`'s (relative to each coefficient).
+inline void expect_coefficients_near(const ModelCoefficients& actual, const ModelCoefficients& expected, double rel) {
+  EXPECT_NEAR(actual.a1, expected.a1, rel * std::abs(expected.a1));
+  EXPECT_NEAR(actual.a2, expected.a2, rel * std::abs(expected.a2));
+  EXPECT_NEAR(actual.a3, expected.a3, rel * std::abs(expected.a3));
+  EXPECT_NEAR(actual.b0, expected.b0, rel * std::abs(expected.b0));
+  EXPECT_NEAR(actual.b1, expected.b1, rel * std::abs(expected.b1));
+  EXPECT_NEAR(actual.b2, expected.b2, rel * std::abs(expected.b2));
+  EXPECT_NEAR(actual.d0, expected.d0, rel * std::abs(expected.d0));
+  EXPECT_NEAR(actual.d1, expected.d1, rel * std::abs(expected.d1));
 }
 
 }  // namespace servotwin::rapid::test

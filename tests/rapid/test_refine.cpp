@@ -11,6 +11,7 @@
 
 #include "servotwin/core/error.hpp"
 #include "servotwin/rapid/refine.hpp"
+#include "test_axis_model_support.hpp"
 
 namespace servotwin::rapid {
 namespace {
@@ -58,16 +59,7 @@ ModelCoefficients perturbed(const ModelCoefficients& c) {
   return s;
 }
 
-void expect_coefficients_near(const ModelCoefficients& a, const ModelCoefficients& b, double rel) {
-  EXPECT_NEAR(a.a1, b.a1, rel * std::abs(b.a1));
-  EXPECT_NEAR(a.a2, b.a2, rel * std::abs(b.a2));
-  EXPECT_NEAR(a.a3, b.a3, rel * std::abs(b.a3));
-  EXPECT_NEAR(a.b0, b.b0, rel * std::abs(b.b0));
-  EXPECT_NEAR(a.b1, b.b1, rel * std::abs(b.b1));
-  EXPECT_NEAR(a.b2, b.b2, rel * std::abs(b.b2));
-  EXPECT_NEAR(a.d0, b.d0, rel * std::abs(b.d0));
-  EXPECT_NEAR(a.d1, b.d1, rel * std::abs(b.d1));
-}
+using test::expect_coefficients_near;
 
 RefineOptions exact_options() {
   RefineOptions o;

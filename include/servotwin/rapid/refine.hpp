@@ -15,9 +15,10 @@
 /// identification) and its first measured position, friction switching included, subject to
 /// p in [p_min, p_max], wn in [wn_min, wn_max], zeta in [zeta_min, zeta_max].
 ///
-/// Method: core::levenberg_marquardt (box bounds, QR steps, central-difference Jacobian) over the
-/// unit-free parameters (ln p, ln wn, zeta, b0, b1/a1, b2/a2, d0/(a2 e), d1/(a2 e)) with the start's
-/// a1, a2 and e = RMS measured tracking error, so nothing depends on the length unit. A local
+/// Method: core::levenberg_marquardt (box bounds, QR steps, forward-difference Jacobian: one
+/// simulation per parameter) over the unit-free parameters (ln p, ln wn, zeta, b0, b1/a1, b2/a2,
+/// d0/(a2 e), d1/(a2 e)) with the current a1, a2 (so that moving the poles moves the zeros with
+/// them) and e = RMS measured tracking error, so nothing depends on the length unit. A local
 /// method: it refines a good start (the exact solution) and never returns a worse model than its
 /// start; coefficients that the start has at exactly 0 (regressors the solver fixed, e.g. friction
 /// without direction reversals) stay 0.
