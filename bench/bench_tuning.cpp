@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "servotwin/fit/plant_model.hpp"
+#include "servotwin/tuning/hinf.hpp"
 #include "servotwin/tuning/lqg.hpp"
 #include "servotwin/tuning/normalized_plant.hpp"
 #include "servotwin/tuning/pi_design.hpp"
@@ -119,7 +120,8 @@ BENCHMARK(BM_LargestRobustOmegaStar)->Arg(30)->Arg(48)->Unit(benchmark::kMillise
 // normalization, advice, admissible range, the automatic ω* scan (24 candidates + refinement, each
 // a placement, a Routh test, two peaks and a bandwidth with the HF dynamics), the final analysis
 // (indices, margins, time responses). Arg 0: PI; 1: PI with an uncertainty weight (RP in the scan);
-// 2: PID; 3: PI + P position loop; 4: LQG (kbw and kff searches, C7.13); 5: LQG with W2.
+// 2: PID; 3: PI + P position loop; 4: LQG (kbw and kff searches, C7.13); 5: LQG with W2;
+// 6: H∞ with the automatic ω0S/ω0T search (C7.14; issue §9: <= 1 s).
 void BM_TuneAutomatic(benchmark::State& state) {
   const fit::PlantModel model = belt_axis();
   TuneOptions o;
@@ -143,13 +145,29 @@ void BM_TuneAutomatic(benchmark::State& state) {
       o.structure = Structure::kLqg;
       o.w2 = core::TransferFunction(core::Polynomial{0.5 / wz, 0.05}, core::Polynomial{1.0 / wz, 1.0});
       break;
+    case 6:  // hinf: the w0S scan with the w0T ladder, each candidate a gamma iteration
+      o.structure = Structure::kHinf;
+      break;
     default:
       break;
   }
   for (auto _ : state) benchmark::DoNotOptimize(tune(model, o));
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_TuneAutomatic)->DenseRange(0, 5)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TuneAutomatic)->DenseRange(0, 6)->Unit(benchmark::kMillisecond);
+
+/// One C7.14 velocity design (generalized plant, gamma iteration to 1e-4 with the closed loop
+/// checked near the optimum, K0/s): the inner step of the w0S search; a few milliseconds.
+void BM_VelocityHinfDesign(benchmark::State& state) {
+  const NormalizedPlant plant = normalized_two_mass(3.0, 0.01);
+  VelocityHinfWeights w;
+  w.omega_0s = 0.6;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(velocity_hinf(plant, w));
+    w.omega_0s += 1e-9;
+  }
+}
+BENCHMARK(BM_VelocityHinfDesign)->Unit(benchmark::kMillisecond);
 
 /// One LQG design (two 4x4 or 5x5 Riccati solves, the compensator and every pole set): the inner
 /// step of a kbw search, so it should stay well under a millisecond.

@@ -31,6 +31,8 @@ struct TuneArgs {
   double zeta_star = 0.8;
   std::string omega_star = "auto";
   std::string kbw = "auto", kff = "auto";
+  std::string omega_0s = "auto", omega_0t = "auto";
+  double xi_v = 0.8;
   bool raw_motor_velocity = false;
   std::optional<double> measurement_noise;
   double target_r = 2.0;
@@ -59,6 +61,9 @@ tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
   o.omega_star = parse_auto(a.omega_star, "--omega-star", false, "omega*/omega_z > 0");
   o.kbw = parse_auto(a.kbw, "--kbw", false, "a bandwidth knob > 0");
   o.feedforward = parse_auto(a.kff, "--kff", true, "a normalized feedforward gain >= 0");
+  o.omega_0s = parse_auto(a.omega_0s, "--omega-0s", false, "w0S/omega_z > 0");
+  o.omega_0t = parse_auto(a.omega_0t, "--omega-0t", false, "w0T/omega_z > 0");
+  o.xi_v = a.xi_v;
   o.lqg.raw_motor_velocity = a.raw_motor_velocity;
   if (a.measurement_noise) {
     o.lqg.measurement_noise = *a.measurement_noise;  // the user's V is kept, not raised
@@ -111,6 +116,16 @@ void print_lqg(tuning::Structure structure, const tuning::FullOrderSummary& f, c
   fmt::print("compensator: {}\n", f.controller_stable ? "stable" : "UNSTABLE (stable only inside the closed loop)");
 }
 
+/// The H-infinity part of the summary: the weights, gamma and the controller's stability.
+void print_hinf(const tuning::FullOrderSummary& f, double hz) {
+  const tuning::HinfSummary& h = *f.hinf;
+  fmt::print("structure hinf: mixed-sensitivity velocity loop (C7.14, {} states): w0S = {:.4g} omega_z = {:.4g} Hz "
+             "({}), w0T = {:.4g} omega_z, xi_v = {}; gamma = {:.4g} (optimum {:.4g})\n",
+             f.compensator.states(), h.omega_0s, h.omega_0s * hz, h.omega_0s_source, h.omega_0t, h.xi_v, h.gamma,
+             h.gamma_optimal);
+  fmt::print("controller: {}\n", f.controller_stable ? "stable" : "UNSTABLE (stable only inside the closed loop)");
+}
+
 void print_summary(const tuning::TuneResult& r, const std::string& source) {
   const tuning::NormalizedPlant& p = r.plant;
   const tuning::Controller& c = r.controller;
@@ -119,7 +134,9 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
              "rigid pole a = {:.3g} omega_z, Im = {:.5g}{}\n",
              source, hz, p.r, p.zeta_z, p.zeta_p, p.a, p.motor_inertia,
              p.higher_modes.empty() ? "" : fmt::format(", {} higher mode(s)", p.higher_modes.size()));
-  if (c.full_order) {
+  if (c.full_order && c.full_order->hinf) {
+    print_hinf(*c.full_order, hz);
+  } else if (c.full_order) {
     print_lqg(c.structure, *c.full_order, c.plant);
   } else {
     print_cascade(r, hz);
@@ -219,15 +236,16 @@ void register_tune(CLI::App& app, Action& selected) {
   auto a = std::make_shared<TuneArgs>();
   CLI::App* cmd = app.add_subcommand(
       "tune",
-      "Tune a cascade PI/PID velocity loop (and P position loop) or a full-order LQG for a flexible drive from its "
-      "plant model");
+      "Tune a cascade PI/PID velocity loop (and P position loop) or a full-order LQG or H-infinity controller for a "
+      "flexible drive from its plant model");
   cmd->add_option("plant", a->plant,
                   "Plant: a fitted model (servotwin.plant-model/1 from `servotwin fit`), a plant description "
                   "(servotwin.plant/1) or a flexible preset name");
   cmd->add_option("--structure", a->structure,
                   "pi, pid (virtual inertia, C7.5), pi+p (P position loop over the PI), lqg (full-order velocity "
-                  "LQG, C7.13) or lqg+p (P position loop over the LQG)")
-      ->check(CLI::IsMember({"pi", "pid", "pi+p", "lqg", "lqg+p"}))
+                  "LQG, C7.13), lqg+p (P position loop over the LQG) or hinf (H-infinity mixed-sensitivity velocity "
+                  "loop, C7.14)")
+      ->check(CLI::IsMember({"pi", "pid", "pi+p", "lqg", "lqg+p", "hinf"}))
       ->capture_default_str();
   cmd->add_option("--zeta-star", a->zeta_star, "Damping of the assigned closed-loop pole pair")->capture_default_str();
   cmd->add_option("--omega-star", a->omega_star,
@@ -247,6 +265,16 @@ void register_tune(CLI::App& app, Action& selected) {
   cmd->add_option("--measurement-noise", a->measurement_noise,
                   "LQG: Kalman-filter measurement-noise intensity V; larger = a slower estimator, for loops with "
                   "delay or a noisy encoder (default: C7.13's 0.1, raised by decades when no kbw meets the spec)");
+  cmd->add_option("--omega-0s", a->omega_0s,
+                  "H-infinity: w0S/omega_z, the dominant closed-loop pole pair of the weights V and W2, or auto: the "
+                  "largest load bandwidth within --ms/--mt (C7.14's search)")
+      ->capture_default_str();
+  cmd->add_option("--omega-0t", a->omega_0t,
+                  "H-infinity: w0T/omega_z, the bandwidth cap of W2, or auto: r, raised to 2r, 4r, 8r while the spec "
+                  "fails")
+      ->capture_default_str();
+  cmd->add_option("--xi-v", a->xi_v, "H-infinity: damping of the relocated resonant pair, in [0.707, 1]")
+      ->capture_default_str();
   cmd->add_option("--target-r", a->target_r, "PID: virtual resonance ratio r-bar the derivative gain creates")
       ->capture_default_str();
   cmd->add_option("--tau", a->tau, "PID: derivative filter time constant [s] (default: 1/max(r, 5 omega*) in omega_z units)");
@@ -262,6 +290,7 @@ void register_tune(CLI::App& app, Action& selected) {
                "  servotwin tune table-5.1 --structure pi+p --omega-star 0.4 --zeta-star 1 --report tune.html\n"
                "  servotwin tune plant_model.json --w2-from-frf frf.csv\n"
                "  servotwin tune table-5.1 --structure lqg --ts 0.000125 -o lqg.json --report lqg.html\n"
+               "  servotwin tune table-5.1 --structure hinf --ts 0.000125 -o hinf.json\n"
                "  servotwin tune plant_model.json --delay 0.0005 --w2-num 2.6,0 --w2-den 1,15 --ms 1.6\n");
   add_tune_compare(*cmd, selected);
   cmd->callback([a, cmd, &selected] {

@@ -26,7 +26,7 @@ namespace {
 
 struct TuneCompareArgs {
   std::string plant;
-  std::string structures = "pi,pid,lqg";
+  std::string structures = "pi,pid,lqg,hinf";
   double target_r = 2.0;
   TuneSpecArgs spec;
   std::string report;
@@ -41,7 +41,7 @@ std::vector<tuning::Structure> parse_structures(const std::string& text) {
     const auto s = tuning::structure_from_string(name);
     if (!s || tuning::has_position_loop(*s))
       throw core::InputError(core::at_field("--structures"),
-                             "expected a comma-separated list of pi, pid, lqg, got \"" + name + "\"");
+                             "expected a comma-separated list of pi, pid, lqg, hinf, got \"" + name + "\"");
     out.push_back(*s);
     start = end + 1;
   }
@@ -71,8 +71,9 @@ void print_comparison(const std::vector<tuning::StructureComparison>& comparison
     const LoopIndices& i = k.predicted;
     const bool load = !std::isnan(i.bandwidth_load);
     const double bw = load ? i.bandwidth_load : i.bandwidth_motor;
-    const std::string design = k.full_order ? fmt::format("kbw {:.4g}", k.full_order->weights.kbw)
-                                            : fmt::format("w*/wz {:.4g}", k.design.omega_star);
+    const std::string design = k.full_order && k.full_order->hinf ? fmt::format("w0S/wz {:.4g}", k.full_order->hinf->omega_0s)
+                               : k.full_order ? fmt::format("kbw {:.4g}", k.full_order->weights.kbw)
+                                              : fmt::format("w*/wz {:.4g}", k.design.omega_star);
     const double velocity_per_torque = 1.0 / (plant.motor_inertia * plant.omega_z);
     fmt::print("{:<6} {:>16} {:>12} {:>7} {:>7} {:>8} {:>11} {:>7} {:>9} {:>7} {:>9}  {}\n", name, design, comparison_cell(bw * hz),
                times_pi(tuning::relative_to_pi(comparison, load ? &LoopIndices::bandwidth_load : &LoopIndices::bandwidth_motor, bw)),
@@ -152,7 +153,7 @@ void add_tune_compare(CLI::App& tune, Action& selected) {
                   "Plant: a fitted model (servotwin.plant-model/1), a plant description (servotwin.plant/1) or a "
                   "flexible preset name")
       ->required();
-  cmd->add_option("--structures", a->structures, "Comma-separated structures to compare (pi, pid, lqg)")
+  cmd->add_option("--structures", a->structures, "Comma-separated structures to compare (pi, pid, lqg, hinf)")
       ->capture_default_str();
   cmd->add_option("--target-r", a->target_r, "PID: virtual resonance ratio r-bar (C7.15 uses 2)")->capture_default_str();
   add_spec_options(*cmd, a->spec);

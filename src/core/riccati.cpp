@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <complex>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -53,10 +54,15 @@ Residual care_residual(const Eigen::MatrixXd& a, const Eigen::MatrixXd& g, const
 }
 
 /// Matrix sign function by the scaled Newton iteration Z <- (Z/c + c Z^-1)/2, c = |det Z|^(1/N).
-/// Returns false when the iteration does not converge (eigenvalues on or near the imaginary axis).
+/// Converged when the relative change falls below 1e-13, or when it has reached its rounding floor:
+/// below 1e-10 (the quadratic phase has ended) and no longer halving (Higham, Functions of
+/// Matrices, sec. 5.8); ill-conditioned Hamiltonians (H-infinity weights) stagnate near 1e-12,
+/// and the Newton–Kleinman refinement of the caller restores the accuracy. Returns false when the
+/// iteration does not converge (eigenvalues on or near the imaginary axis).
 bool matrix_sign(Eigen::MatrixXd& z, int& iterations) {
   const Eigen::Index size = z.rows();
   constexpr int kMaxIterations = 100;
+  double previous_change = std::numeric_limits<double>::infinity();
   for (iterations = 0; iterations < kMaxIterations; ++iterations) {
     const Eigen::PartialPivLU<Eigen::MatrixXd> lu(z);
     // log|det Z| summed from the LU diagonal: det itself over/underflows for large N.
@@ -66,13 +72,14 @@ bool matrix_sign(Eigen::MatrixXd& z, int& iterations) {
     const double c = std::exp(log_det / static_cast<double>(size));
     const Eigen::MatrixXd next = 0.5 * (z / c + c * lu.inverse());
     if (!next.allFinite()) return false;
-    const double change = (next - z).lpNorm<1>();
-    const double norm = next.lpNorm<1>();
+    const double change = (next - z).lpNorm<1>() / next.lpNorm<1>();
     z = next;
-    if (change <= 1e-13 * norm) {
+    const bool at_rounding_floor = previous_change <= 1e-10 && change > 0.5 * previous_change;
+    if (change <= 1e-13 || at_rounding_floor) {
       ++iterations;
       return true;
     }
+    previous_change = change;
   }
   return false;
 }
@@ -114,22 +121,27 @@ Eigen::MatrixXd solve_lyapunov(const Eigen::MatrixXd& A, const Eigen::MatrixXd& 
   return x;
 }
 
-Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q,
-                           const Eigen::MatrixXd& R, CareReport* report) {
-  check_care_inputs(A, B, Q, R);
-  const Eigen::Index n = A.rows();
-  const Eigen::MatrixXd q = 0.5 * (Q + Q.transpose());
-  const Eigen::MatrixXd r_inv_bt = R.llt().solve(B.transpose());
-  Eigen::MatrixXd g = B * r_inv_bt;
-  g = 0.5 * (g + g.transpose()).eval();
+namespace {
 
-  Eigen::MatrixXd z(2 * n, 2 * n);
-  z << A, -g, -q, -A.transpose();
+/// The stabilizing solution of A^T X + X A - X G X + Q = 0 for symmetric G and Q of any inertia:
+/// the sign function of the Hamiltonian, then Newton–Kleinman refinement. `who` names the caller
+/// in the error messages.
+Eigen::MatrixXd stabilizing_solution(const Eigen::MatrixXd& a, const Eigen::MatrixXd& g, const Eigen::MatrixXd& q,
+                                     CareReport* report, const std::string& who, double residual_tolerance = 1e-8) {
+  const Eigen::Index n = a.rows();
   CareReport diag;
+  // Q = 0 with A Hurwitz: X = 0 is the (unique) stabilizing solution, which the sign function
+  // would only find up to rounding noise that no relative residual can judge.
+  if (q.isZero(0.0) && is_hurwitz(a)) {
+    if (report != nullptr) *report = diag;
+    return Eigen::MatrixXd::Zero(n, n);
+  }
+  Eigen::MatrixXd z(2 * n, 2 * n);
+  z << a, -g, -q, -a.transpose();
   if (!matrix_sign(z, diag.sign_iterations))
-    throw std::domain_error(
-        "solve_care: the Hamiltonian has eigenvalues on the imaginary axis; no stabilizing solution "
-        "((A, B) not stabilizable or (Q, A) not detectable)");
+    throw std::domain_error(who +
+                            ": the Hamiltonian has eigenvalues on the imaginary axis; no stabilizing solution "
+                            "((A, B) not stabilizable or (Q, A) not detectable)");
   // sign(H) [I; X] = -[I; X]  =>  [W12; W22 + I] X = [-(I + W11); -W21].
   Eigen::MatrixXd lhs(2 * n, n), rhs(2 * n, n);
   lhs << z.topRightCorner(n, n), z.bottomRightCorner(n, n) + Eigen::MatrixXd::Identity(n, n);
@@ -138,28 +150,58 @@ Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, c
   x = 0.5 * (x + x.transpose()).eval();
 
   // Newton–Kleinman on the residual: (A - G X)^T D + D (A - G X) = -Res(X), X <- X + D.
-  Residual res = care_residual(A, g, q, x);
+  Residual res = care_residual(a, g, q, x);
   constexpr int kMaxRefinements = 4;
   for (int step = 0; step < kMaxRefinements && res.relative > 1e-15; ++step) {
-    const Eigen::MatrixXd closed = A - g * x;
+    const Eigen::MatrixXd closed = a - g * x;
     Eigen::MatrixXd candidate;
     try {
       candidate = x + solve_lyapunov(closed, res.value);
     } catch (const std::domain_error&) {
       break;  // closed loop not yet stabilizing: keep the sign-function solution
     }
-    Residual next = care_residual(A, g, q, candidate);
+    Residual next = care_residual(a, g, q, candidate);
     if (!(next.relative < res.relative)) break;
     x = 0.5 * (candidate + candidate.transpose());
-    res = care_residual(A, g, q, x);
+    res = care_residual(a, g, q, x);
     ++diag.refinement_steps;
   }
   diag.relative_residual = res.relative;
-  if (!x.allFinite() || !is_hurwitz(A - g * x) || res.relative > 1e-8)
-    throw std::domain_error("solve_care: no stabilizing solution found (relative residual " +
-                            std::to_string(res.relative) + ")");
+  if (!x.allFinite() || !is_hurwitz(a - g * x) || res.relative > residual_tolerance) {
+    char residual[32];
+    std::snprintf(residual, sizeof residual, "%.3g", res.relative);
+    throw std::domain_error(who + ": no stabilizing solution found (relative residual " + residual + ")");
+  }
   if (report != nullptr) *report = diag;
   return x;
+}
+
+}  // namespace
+
+Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q,
+                           const Eigen::MatrixXd& R, CareReport* report) {
+  check_care_inputs(A, B, Q, R);
+  const Eigen::MatrixXd q = 0.5 * (Q + Q.transpose());
+  const Eigen::MatrixXd r_inv_bt = R.llt().solve(B.transpose());
+  Eigen::MatrixXd g = B * r_inv_bt;
+  g = 0.5 * (g + g.transpose()).eval();
+  return stabilizing_solution(A, g, q, report, "solve_care");
+}
+
+Eigen::MatrixXd solve_care_indefinite(const Eigen::MatrixXd& A, const Eigen::MatrixXd& G, const Eigen::MatrixXd& Q,
+                                      CareReport* report, double residual_tolerance) {
+  const Eigen::Index n = A.rows();
+  const auto require = [](bool condition, const std::string& message) {
+    if (!condition) throw std::invalid_argument("solve_care_indefinite: " + message);
+  };
+  require(n > 0 && A.cols() == n, "A must be square and non-empty");
+  require(G.rows() == n && G.cols() == n && Q.rows() == n && Q.cols() == n, "G and Q must be n x n");
+  require(A.allFinite() && G.allFinite() && Q.allFinite(), "matrices must be finite");
+  require(symmetry_defect(G) <= 1e-10 && symmetry_defect(Q) <= 1e-10, "G and Q must be symmetric");
+  const Eigen::MatrixXd g = 0.5 * (G + G.transpose());
+  const Eigen::MatrixXd q = 0.5 * (Q + Q.transpose());
+  require(residual_tolerance >= 1e-14 && residual_tolerance <= 1e-2, "residual_tolerance must lie in [1e-14, 1e-2]");
+  return stabilizing_solution(A, g, q, report, "solve_care_indefinite", residual_tolerance);
 }
 
 Eigen::MatrixXd solve_care_filter(const Eigen::MatrixXd& A, const Eigen::MatrixXd& C, const Eigen::MatrixXd& W,

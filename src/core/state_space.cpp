@@ -330,6 +330,11 @@ std::pair<Polynomial, Polynomial> characteristic_polynomial(const Eigen::MatrixX
 
 }  // namespace
 
+StateSpace balance_states(const StateSpace& sys) {
+  check_system(sys, "balance_states");
+  return detail::balanced(sys);
+}
+
 Eigen::MatrixXd dc_gain(const StateSpace& sys) {
   check_system(sys, "dc_gain");
   if (sys.states() == 0) return sys.D;

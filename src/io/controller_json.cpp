@@ -180,10 +180,30 @@ json state_space_json(const core::StateSpace& ss, const std::string& section) {
           {"D", matrix_json(ss.D, section + ".D")}};
 }
 
+/// The compensator members common to the lqg and hinf sections.
+void add_compensator(json& section, const tuning::FullOrderSummary& f, const std::string& name) {
+  section["controller_stable"] = f.controller_stable;
+  section["controller_poles"] = poles_json(f.controller_poles, name + ".controller_poles");
+  section["compensator"] = state_space_json(f.compensator, name + ".compensator");
+}
+
+json hinf_json(const std::optional<tuning::FullOrderSummary>& f) {
+  if (!f || !f->hinf) return nullptr;
+  const tuning::HinfSummary& h = *f->hinf;
+  json out = {{"omega_0s", finite(h.omega_0s, "hinf.omega_0s")},
+              {"omega_0s_source", h.omega_0s_source},
+              {"omega_0t", finite(h.omega_0t, "hinf.omega_0t")},
+              {"xi_v", finite(h.xi_v, "hinf.xi_v")},
+              {"gamma_optimal", finite(h.gamma_optimal, "hinf.gamma_optimal")},
+              {"gamma", finite(h.gamma, "hinf.gamma")}};
+  add_compensator(out, *f, "hinf");
+  return out;
+}
+
 json lqg_json(const std::optional<tuning::FullOrderSummary>& f) {
-  if (!f) return nullptr;
+  if (!f || f->hinf) return nullptr;
   const tuning::VelocityLqgOptions& w = f->weights;
-  return {{"kbw", finite(w.kbw, "lqg.kbw")},
+  json out = {{"kbw", finite(w.kbw, "lqg.kbw")},
           {"kbw_source", f->kbw_source},
           {"feedforward", finite(w.feedforward, "lqg.feedforward")},
           {"feedforward_source", f->feedforward_source},
@@ -192,10 +212,9 @@ json lqg_json(const std::optional<tuning::FullOrderSummary>& f) {
           {"noise_motor", finite(w.noise_motor, "lqg.noise_motor")},
           {"noise_load_torque", finite(w.noise_load_torque, "lqg.noise_load_torque")},
           {"measurement_noise", finite(w.measurement_noise, "lqg.measurement_noise")},
-          {"raw_motor_velocity", w.raw_motor_velocity},
-          {"controller_stable", f->controller_stable},
-          {"controller_poles", poles_json(f->controller_poles, "lqg.controller_poles")},
-          {"compensator", state_space_json(f->compensator, "lqg.compensator")}};
+          {"raw_motor_velocity", w.raw_motor_velocity}};
+  add_compensator(out, *f, "lqg");
+  return out;
 }
 
 // ---------------------------------------------------------------- reader
@@ -599,14 +618,51 @@ void check_poles(const Section& s, std::string_view key, const std::vector<std::
   }
 }
 
+/// Whether the optional section `key` is present (not absent, not null) exactly when `wanted`.
+bool section_present(const Section& root, const char* key, bool wanted, const std::string& owners,
+                     Structure structure) {
+  const bool present = root.value.contains(key) && !root.raw(key).is_null();  // absent in older files
+  if (present != wanted)
+    root.fail(key, wanted ? "an \"" + to_string(structure) + "\" controller needs its compensator section"
+                          : "only " + owners + " controllers have this section (expected null)");
+  return present;
+}
+
+/// The compensator, its poles (checked against its A) and its stability flag (checked against them).
+void read_compensator(const Section& s, tuning::FullOrderSummary& f) {
+  f.compensator = read_controller_matrices(s.section("compensator"));
+  f.controller_poles = read_poles(s, "controller_poles");
+  check_poles(s, "controller_poles", f.controller_poles, f.compensator.A);
+  f.controller_stable = s.boolean("controller_stable");
+  if (f.controller_stable != tuning::stable_except_integrator(f.controller_poles))
+    s.fail("controller_stable", std::string("contradicts controller_poles (they say ") +
+                                    (f.controller_stable ? "unstable" : "stable") + ")");
+}
+
+/// The "hinf" section: the compensator, its weights and gamma for hinf; null otherwise.
+std::optional<tuning::FullOrderSummary> read_hinf(const Section& root, Structure structure) {
+  if (!section_present(root, "hinf", structure == Structure::kHinf, "hinf", structure)) return std::nullopt;
+  const Section s = root.section("hinf");
+  s.object.allow_only({"omega_0s", "omega_0s_source", "omega_0t", "xi_v", "gamma_optimal", "gamma",
+                       "controller_stable", "controller_poles", "compensator"});
+  tuning::FullOrderSummary f;
+  tuning::HinfSummary h;
+  h.omega_0s = s.positive("omega_0s", "a normalized frequency w0S");
+  h.omega_0s_source = s.object.string("omega_0s_source");
+  h.omega_0t = s.positive("omega_0t", "a normalized frequency w0T");
+  h.xi_v = s.positive("xi_v", "a damping ratio");
+  h.gamma_optimal = s.positive("gamma_optimal", "an H-infinity norm");
+  h.gamma = s.positive("gamma", "an H-infinity norm");
+  if (h.gamma < h.gamma_optimal * (1.0 - 1e-9)) s.fail("gamma", "is below gamma_optimal");
+  f.hinf = h;
+  read_compensator(s, f);
+  return f;
+}
+
 /// The "lqg" section: null for the cascade structures, the compensator and its weights for lqg.
 std::optional<tuning::FullOrderSummary> read_lqg(const Section& root, Structure structure) {
-  const bool present = root.value.contains("lqg") && !root.raw("lqg").is_null();  // absent before lqg existed
-  const bool wanted = tuning::is_full_order(structure);
-  if (present != wanted)
-    root.fail("lqg", wanted ? "an \"" + to_string(structure) + "\" controller needs its compensator section"
-                            : "only lqg and lqg+p controllers have a compensator section (expected null)");
-  if (!present) return std::nullopt;
+  const bool wanted = structure == Structure::kLqg || structure == Structure::kLqgP;
+  if (!section_present(root, "lqg", wanted, "lqg and lqg+p", structure)) return std::nullopt;
   const Section s = root.section("lqg");
   s.object.allow_only({"kbw", "kbw_source", "feedforward", "feedforward_source", "q_load_velocity", "q_integral",
                        "noise_motor", "noise_load_torque", "measurement_noise", "raw_motor_velocity",
@@ -623,13 +679,7 @@ std::optional<tuning::FullOrderSummary> read_lqg(const Section& root, Structure 
   w.noise_load_torque = s.non_negative("noise_load_torque", "a noise intensity");
   w.measurement_noise = s.positive("measurement_noise", "a noise intensity");
   w.raw_motor_velocity = s.boolean("raw_motor_velocity");
-  f.compensator = read_controller_matrices(s.section("compensator"));
-  f.controller_poles = read_poles(s, "controller_poles");
-  check_poles(s, "controller_poles", f.controller_poles, f.compensator.A);
-  f.controller_stable = s.boolean("controller_stable");
-  if (f.controller_stable != tuning::stable_except_integrator(f.controller_poles))
-    s.fail("controller_stable", std::string("contradicts controller_poles (they say ") +
-                                    (f.controller_stable ? "unstable" : "stable") + ")");
+  read_compensator(s, f);
   return f;
 }
 
@@ -655,7 +705,9 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
     throw std::invalid_argument("controller_to_json: the position-loop summary belongs to exactly the pi+p and lqg+p controllers");
   const bool full_order = tuning::is_full_order(c.structure);
   if (full_order != c.full_order.has_value())
-    throw std::invalid_argument("controller_to_json: the compensator section belongs to exactly the lqg and lqg+p controllers");
+    throw std::invalid_argument("controller_to_json: the compensator section belongs to exactly the lqg, lqg+p and hinf controllers");
+  if ((c.structure == Structure::kHinf) != (c.full_order && c.full_order->hinf.has_value()))
+    throw std::invalid_argument("controller_to_json: the H-infinity summary belongs to exactly the hinf controllers");
   const double wz = finite(c.plant.omega_z, "plant.omega_z");
   const tuning::PlantScales& p = c.plant;
   const core::StateSpace ss = tuning::controller_state_space(c);
@@ -700,6 +752,7 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
           {"robustness", robustness_json(c.robustness)},
           {"position", position_json(c, wz)},
           {"lqg", lqg_json(c.full_order)},
+          {"hinf", hinf_json(c.full_order)},
           {"notes", c.notes}};
 }
 
@@ -708,14 +761,14 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
   check_format(document, kControllerFormat, source_name);
   const Section root(document, "", source_name);
   root.object.allow_only({"format", "structure", "loop", "feedback", "plant", "gains", "normalized", "state_space",
-                          "discrete", "design", "predicted", "robustness", "position", "lqg", "notes"});
+                          "discrete", "design", "predicted", "robustness", "position", "lqg", "hinf", "notes"});
   LoadedController out;
   tuning::Controller& c = out.controller;
 
   const std::string structure = root.object.string("structure");
   const auto parsed = tuning::structure_from_string(structure);
   if (!parsed)
-    root.fail("structure", "expected \"pi\", \"pid\", \"pi+p\", \"lqg\" or \"lqg+p\", got \"" + structure + "\"");
+    root.fail("structure", "expected \"pi\", \"pid\", \"pi+p\", \"lqg\", \"lqg+p\" or \"hinf\", got \"" + structure + "\"");
   c.structure = *parsed;
   const std::string loop = root.object.string("loop");
   if (loop != "velocity" && loop != "position")
@@ -733,6 +786,7 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
     }
   }
   c.full_order = read_lqg(root, c.structure);
+  if (auto hinf = read_hinf(root, c.structure)) c.full_order = std::move(hinf);
   if (!c.full_order) {
     const Section gains = root.section("gains");
     const GainsRead physical = read_gains(gains, c.structure);

@@ -74,8 +74,10 @@ std::vector<double> frequency_grid(const tuning::NormalizedPlant& p, std::size_t
   return grid;
 }
 
-/// What the design chose: ω* for the pole-placement structures, kbw for the LQG.
+/// What the design chose: ω* for the pole-placement structures, kbw for the LQG, ω0S for H∞.
 std::string design_parameter(const tuning::Controller& c) {
+  if (c.full_order && c.full_order->hinf)
+    return fmt::format("ω0S/ωz = {}, γ = {}", num(c.full_order->hinf->omega_0s, 4), num(c.full_order->hinf->gamma, 4));
   if (c.full_order) return fmt::format("kbw = {}", num(c.full_order->weights.kbw, 4));
   return fmt::format("ω*/ωz = {}", num(c.design.omega_star, 4));
 }

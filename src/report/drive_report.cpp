@@ -112,8 +112,13 @@ Table gains_table(const vcnc::DriveSimulation& s) {
   if (s.full_order) {
     const tuning::FullOrderSummary& f = *s.full_order;
     t.rows.push_back({"compensator states", std::to_string(f.compensator.states())});
-    t.rows.push_back({"kbw", num(f.weights.kbw, 4)});
-    t.rows.push_back({"feedforward kff (normalized)", num(f.weights.feedforward, 4)});
+    if (f.hinf) {
+      t.rows.push_back({"ω0S/ωz, ω0T/ωz", num(f.hinf->omega_0s, 4) + ", " + num(f.hinf->omega_0t, 4)});
+      t.rows.push_back({"γ", num(f.hinf->gamma, 4)});
+    } else {
+      t.rows.push_back({"kbw", num(f.weights.kbw, 4)});
+      t.rows.push_back({"feedforward kff (normalized)", num(f.weights.feedforward, 4)});
+    }
     t.rows.push_back({"compensator", f.controller_stable ? "stable" : "UNSTABLE (stable only in closed loop)"});
   } else {
     t.rows.push_back({"Kp", num(s.gains.kp, 6)});

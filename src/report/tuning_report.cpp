@@ -334,10 +334,11 @@ Table scan_table(const Context& c) {
   return t;
 }
 
-Table kbw_scan_table(const Context& c) {
+/// The automatic scan of the full-order knob: kbw (lqg) or w0S (hinf).
+Table knob_scan_table(const Context& c, const std::string& knob) {
   Table t;
-  t.title = "Automatic kbw scan";
-  t.header = {"kbw", "stable", "bandwidth [Hz]", "‖S‖∞", "tracking peak", "within the limits"};
+  t.title = "Automatic " + knob + " scan";
+  t.header = {knob, "stable", "bandwidth [Hz]", "‖S‖∞", "tracking peak", "within the limits"};
   for (const tuning::TuneResult::Candidate& k : c.result.scan) {
     t.rows.push_back({num(k.omega_star, 4), yes_no(k.stable), k.stable ? num(c.to_hz(k.bandwidth)) : "-",
                       k.stable ? num(k.peak_s, 4) : "-", k.stable ? num(k.peak_tracking, 4) : "-", yes_no(k.feasible)});
@@ -363,6 +364,22 @@ Table poles_table(const Context& c) {
   return t;
 }
 
+/// The rows every full-order design shows: its states, its own stability, its poles (one row per
+/// real pole and per pair, with their frequency) and the discretization; `name` is what the
+/// design calls it ("compensator", "controller").
+void add_compensator_rows(Table& t, const Context& c, const tuning::FullOrderSummary& f, const std::string& name,
+                          const std::string& states_note) {
+  t.rows.push_back({name + " states", std::to_string(f.compensator.states()), states_note});
+  t.rows.push_back({name, f.controller_stable ? "stable" : "UNSTABLE", "stable only inside the closed loop when unstable"});
+  for (const Complex& p : f.controller_poles) {
+    if (p.imag() < 0.0) continue;
+    t.rows.push_back({name + " pole", fmt::format("{} {} {}j", num(p.real(), 4), p.imag() > 0.0 ? "±" : "+", num(p.imag(), 4)),
+                      fmt::format("{} Hz", num(c.to_hz(std::abs(p)), 4))});
+  }
+  if (c.controller.discrete)
+    t.rows.push_back({"discretized (Tustin) at ts", num(c.controller.discrete->ts * 1e3, 5) + " ms", ""});
+}
+
 Table lqg_table(const Context& c) {
   const tuning::FullOrderSummary& f = *c.controller.full_order;
   const tuning::VelocityLqgOptions& w = f.weights;
@@ -379,15 +396,7 @@ Table lqg_table(const Context& c) {
   t.rows.push_back({"process noise into ωm, into Tl", num(w.noise_motor, 4) + ", " + num(w.noise_load_torque, 4), ""});
   t.rows.push_back({"measurement noise V", num(w.measurement_noise, 4), ""});
   t.rows.push_back({"motor velocity fed back", w.raw_motor_velocity ? "measured" : "estimated", ""});
-  t.rows.push_back({"compensator states", std::to_string(f.compensator.states()), ""});
-  t.rows.push_back({"compensator", f.controller_stable ? "stable" : "UNSTABLE", "stable only inside the closed loop when unstable"});
-  for (const Complex& p : f.controller_poles) {
-    if (p.imag() < 0.0) continue;
-    t.rows.push_back({"compensator pole", fmt::format("{} {} {}j", num(p.real(), 4), p.imag() > 0.0 ? "±" : "+", num(p.imag(), 4)),
-                      fmt::format("{} Hz", num(c.to_hz(std::abs(p)), 4))});
-  }
-  if (c.controller.discrete)
-    t.rows.push_back({"discretized (Tustin) at ts", num(c.controller.discrete->ts * 1e3, 5) + " ms", ""});
+  add_compensator_rows(t, c, f, "compensator", "");
   return t;
 }
 
@@ -406,13 +415,49 @@ Section lqg_design_section(const Context& c) {
                           c.result.scan.size());
   for (const std::string& note : k.notes) s.text += "\n\nNote: " + note;
   s.tables.push_back(lqg_table(c));
-  if (!c.result.scan.empty()) s.tables.push_back(kbw_scan_table(c));
+  if (!c.result.scan.empty()) s.tables.push_back(knob_scan_table(c, "kbw"));
+  s.tables.push_back(poles_table(c));
+  return s;
+}
+
+Table hinf_table(const Context& c) {
+  const tuning::FullOrderSummary& f = *c.controller.full_order;
+  const tuning::HinfSummary& h = *f.hinf;
+  Table t;
+  t.title = "H∞ mixed-sensitivity design (C7.14, normalized weights)";
+  t.header = {"parameter", "value", "note"};
+  t.rows.push_back({"ω0S / ωz", num(h.omega_0s, 5), fmt::format("{} Hz; {}", num(c.to_hz(h.omega_0s), 4), h.omega_0s_source)});
+  t.rows.push_back({"ω0T / ωz", num(h.omega_0t, 5), "bandwidth cap of W2"});
+  t.rows.push_back({"ξv", num(h.xi_v, 4), "damping the resonant pair is moved to"});
+  t.rows.push_back({"γ (optimum)", num(h.gamma_optimal, 5), "sup √(|W1 S V|² + |W2 U V|²) of the best controller"});
+  t.rows.push_back({"γ of the controller", num(h.gamma, 5), "1 % above the optimum: a well-conditioned central controller"});
+  add_compensator_rows(t, c, f, "controller", "K = K0/s (integral action)");
+  return t;
+}
+
+Section hinf_design_section(const Context& c) {
+  const tuning::Controller& k = c.controller;
+  Section s;
+  s.title = "Design";
+  s.text = fmt::format(
+      "H∞ mixed-sensitivity velocity controller (C7.14) on the first mode's plant Pe = Pm/s: W1 = 1/Ms, W2 = (1/Mt)"
+      "(s + ω0T)²(s + r)²/[(s + ω0S)²(s² + 2ξv r s + r²)(ω0T r)²] and the pole-relocating V = (s + ω0S)²(s² + 2ξv r s + "
+      "r²)/den(Pe), so that the controller damps the resonance instead of notching it; ω0S = {} ωz ({}).",
+      num(k.full_order->hinf->omega_0s, 4), k.full_order->hinf->omega_0s_source);
+  if (!c.result.scan.empty())
+    s.text += fmt::format(" The search evaluated {} values of ω0S from 0.05 ωz to 2r ωz, each with the first ω0T of r, 2r, "
+                          "4r, 8r that met the spec, the boundary refined by bisection.",
+                          c.result.scan.size());
+  for (const std::string& note : k.notes) s.text += "\n\nNote: " + note;
+  s.tables.push_back(hinf_table(c));
+  if (!c.result.scan.empty()) s.tables.push_back(knob_scan_table(c, "ω0S/ωz"));
   s.tables.push_back(poles_table(c));
   return s;
 }
 
 Section design_section(const Context& c, bool load) {
   const tuning::Controller& k = c.controller;
+  if (k.full_order && k.full_order->hinf) return hinf_design_section(c);
   if (k.full_order) return lqg_design_section(c);
   Section s;
   s.title = "Design";
@@ -716,8 +761,10 @@ Document tuning_report(const tuning::TuneResult& result, const TuningReportOptio
   const auto& f = result.controller.full_order;
   doc.subtitle = fmt::format("{}{}antiresonance {} Hz, r = {}, {}", options.source, options.source.empty() ? "" : ": ",
                              num(c.to_hz(1.0), 4), num(plant.r, 4),
-                             f ? fmt::format("kbw = {}", num(f->weights.kbw, 4))
-                               : fmt::format("ω* = {} Hz", num(c.to_hz(result.controller.design.omega_star), 4)));
+                             f && f->hinf ? fmt::format("ω0S = {} Hz, γ = {}", num(c.to_hz(f->hinf->omega_0s), 4),
+                                                        num(f->hinf->gamma, 4))
+                             : f ? fmt::format("kbw = {}", num(f->weights.kbw, 4))
+                                 : fmt::format("ω* = {} Hz", num(c.to_hz(result.controller.design.omega_star), 4)));
   doc.sections.push_back(plant_section(c));
   doc.sections.push_back(design_section(c, loop.has_load()));
   doc.sections.push_back(loop_section(c, loop));

@@ -1,5 +1,6 @@
 #include "checks.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -52,6 +53,17 @@ void require_grid(double omega_min, double omega_max, std::size_t grid_points, d
     throw core::InputError(core::at_field(prefix + "grid_points"), "expected 2 .. 1e6 grid points");
   if (!(rel_tol >= 1e-12 && rel_tol <= 0.1))
     throw core::InputError(core::at_field(prefix + "rel_tol"), "expected a tolerance in [1e-12, 0.1], got " + show(rel_tol));
+}
+
+std::vector<std::complex<double>> sorted_poles(const Eigen::MatrixXd& a) {
+  using Complex = std::complex<double>;
+  const Eigen::VectorXcd e = a.eigenvalues();
+  std::vector<Complex> out(e.data(), e.data() + e.size());
+  std::sort(out.begin(), out.end(), [](Complex x, Complex y) {
+    if (std::abs(std::abs(x) - std::abs(y)) > 1e-12 * std::max(1.0, std::abs(x))) return std::abs(x) < std::abs(y);
+    return x.imag() > y.imag();
+  });
+  return out;
 }
 
 }  // namespace servotwin::tuning::detail

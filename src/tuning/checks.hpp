@@ -3,6 +3,9 @@
 #include <complex>
 #include <cstddef>
 #include <string>
+#include <vector>
+
+#include <Eigen/Dense>
 
 namespace servotwin::tuning::detail {
 
@@ -25,5 +28,9 @@ void require_pair(double omega_star, double zeta_star);
 /// "options."): 0 < omega_min < omega_max, 2 .. 1e6 points, rel_tol in [1e-12, 0.1].
 void require_grid(double omega_min, double omega_max, std::size_t grid_points, double rel_tol,
                   const std::string& prefix);
+
+/// Eigenvalues of a compensator's A by modulus, each conjugate pair with the positive imaginary
+/// part first (stable order for files and reports).
+std::vector<std::complex<double>> sorted_poles(const Eigen::MatrixXd& a);
 
 }  // namespace servotwin::tuning::detail

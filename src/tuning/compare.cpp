@@ -8,7 +8,9 @@
 
 namespace servotwin::tuning {
 
-std::vector<Structure> comparison_structures() { return {Structure::kPi, Structure::kPid, Structure::kLqg}; }
+std::vector<Structure> comparison_structures() {
+  return {Structure::kPi, Structure::kPid, Structure::kLqg, Structure::kHinf};
+}
 
 std::vector<StructureComparison> compare_structures(const fit::PlantModel& model, const TuneOptions& options,
                                                     const std::vector<Structure>& structures) {
@@ -16,7 +18,7 @@ std::vector<StructureComparison> compare_structures(const fit::PlantModel& model
   std::optional<core::InputError> first_failure;
   for (const Structure s : structures) {
     if (has_position_loop(s))
-      throw core::InputError(core::at_field("structures"), "expected velocity-loop structures (pi, pid, lqg): " +
+      throw core::InputError(core::at_field("structures"), "expected velocity-loop structures (pi, pid, lqg, hinf): " +
                                                                to_string(s) + " closes the position loop");
     StructureComparison entry;
     entry.structure = s;

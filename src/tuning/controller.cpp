@@ -21,12 +21,14 @@ std::string to_string(Structure structure) {
       return "lqg";
     case Structure::kLqgP:
       return "lqg+p";
+    case Structure::kHinf:
+      return "hinf";
   }
   return "pi";
 }
 
 bool is_full_order(Structure structure) noexcept {
-  return structure == Structure::kLqg || structure == Structure::kLqgP;
+  return structure == Structure::kLqg || structure == Structure::kLqgP || structure == Structure::kHinf;
 }
 
 bool has_position_loop(Structure structure) noexcept {
@@ -34,7 +36,7 @@ bool has_position_loop(Structure structure) noexcept {
 }
 
 std::optional<Structure> structure_from_string(const std::string& name) {
-  for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP, Structure::kLqg, Structure::kLqgP}) {
+  for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP, Structure::kLqg, Structure::kLqgP, Structure::kHinf}) {
     if (to_string(s) == name) return s;
   }
   return std::nullopt;

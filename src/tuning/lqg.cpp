@@ -21,15 +21,7 @@ using Matrix = Eigen::MatrixXd;
 /// largest pole): the integrator's pole at 0 is the only one expected there.
 constexpr double kImaginaryAxisTolerance = 1e-9;
 
-std::vector<Complex> poles_of(const Matrix& a) {
-  const Eigen::VectorXcd e = a.eigenvalues();
-  std::vector<Complex> out(e.data(), e.data() + e.size());
-  std::sort(out.begin(), out.end(), [](Complex x, Complex y) {
-    if (std::abs(std::abs(x) - std::abs(y)) > 1e-12 * std::max(1.0, std::abs(x))) return std::abs(x) < std::abs(y);
-    return x.imag() > y.imag();
-  });
-  return out;
-}
+std::vector<Complex> poles_of(const Matrix& a) { return detail::sorted_poles(a); }
 
 void check_plant(const FrictionTwoMass& p, double r) {
   detail::require_positive(p.stiffness, "stiffness", "a shaft stiffness");

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/norms.hpp"
@@ -44,6 +45,14 @@ void validate(const TuneOptions& o) {
   if (o.feedforward)
     require(std::isfinite(*o.feedforward) && *o.feedforward >= 0.0, "--kff",
             fmt::format("expected a normalized feedforward gain >= 0, got {}", *o.feedforward));
+  if (o.omega_0s)
+    require(std::isfinite(*o.omega_0s) && *o.omega_0s > 0.0, "--omega-0s",
+            fmt::format("expected w0S/omega_z > 0, got {}", *o.omega_0s));
+  if (o.omega_0t)
+    require(std::isfinite(*o.omega_0t) && *o.omega_0t > 0.0, "--omega-0t",
+            fmt::format("expected w0T/omega_z > 0, got {}", *o.omega_0t));
+  require(std::isfinite(o.xi_v) && o.xi_v >= 0.7 && o.xi_v <= 1.0, "--xi-v",
+          fmt::format("expected a damping in [0.707, 1] (catalog C7.14), got {}", o.xi_v));
   if (o.w2) {
     require(o.w2->is_proper(), "--w2", "the uncertainty weight must be proper (numerator degree <= denominator degree)");
     require(core::is_hurwitz(o.w2->den()), "--w2", "the uncertainty weight must be stable (poles in the left half-plane)");
@@ -129,7 +138,9 @@ struct SpecCheck {
   /// with a margin for the scan grid's resolution: the bisections of kbw and kff end on the
   /// boundary, and the final test on the fine grid must still pass there.
   [[nodiscard]] bool robust(const VelocityLoop& loop) const {
-    if (!is_full_order(options.structure)) return robustness(loop, *w2, options.ms, scan_robustness_options()).rp_ok;
+    // A 1-DoF loop (PI/PID, hinf): RP of the disturbance type; the 2-DoF LQG: robust tracking.
+    if (!is_full_order(options.structure) || options.structure == Structure::kHinf)
+      return robustness(loop, *w2, options.ms, scan_robustness_options()).rp_ok;
     constexpr double kScanGridMargin = 1e-3;
     return robust_tracking(loop, *w2, options.mt, scan_robustness_options()).value < 1.0 - kScanGridMargin;
   }
@@ -145,6 +156,22 @@ struct SpecCheck {
 /// The largest-bandwidth feasible candidate, its boundary with the next infeasible one refined
 /// by bisection (feasibility usually ends at a peak limit reached as the loop gets faster).
 /// `evaluate(parameter)` gives the candidate of one parameter (ω*, or kbw for lqg).
+/// Bisection (`steps` geometric steps) between a feasible parameter `lo` and an infeasible `hi`;
+/// every feasible candidate with a larger bandwidth than `chosen` replaces it.
+template <class Evaluate>
+void refine_boundary(double lo, double hi, Evaluate&& evaluate, TuneResult::Candidate& chosen, int steps = 12) {
+  for (int it = 0; it < steps; ++it) {
+    const double mid = std::sqrt(lo * hi);
+    const TuneResult::Candidate c = evaluate(mid);
+    if (c.feasible) {
+      lo = mid;
+      if (c.bandwidth > chosen.bandwidth) chosen = c;
+    } else {
+      hi = mid;
+    }
+  }
+}
+
 template <class Evaluate>
 TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Evaluate&& evaluate) {
   std::size_t best = scan.size();
@@ -153,19 +180,8 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Eva
   }
   if (best == scan.size()) return {};
   TuneResult::Candidate chosen = scan[best];
-  if (best + 1 < scan.size() && !scan[best + 1].feasible) {
-    double lo = scan[best].omega_star, hi = scan[best + 1].omega_star;
-    for (int it = 0; it < 12; ++it) {
-      const double mid = std::sqrt(lo * hi);
-      const TuneResult::Candidate c = evaluate(mid);
-      if (c.feasible) {
-        lo = mid;
-        if (c.bandwidth > chosen.bandwidth) chosen = c;
-      } else {
-        hi = mid;
-      }
-    }
-  }
+  if (best + 1 < scan.size() && !scan[best + 1].feasible)
+    refine_boundary(scan[best].omega_star, scan[best + 1].omega_star, evaluate, chosen);
   return chosen;
 }
 
@@ -178,13 +194,14 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Eva
       at = c.omega_star;
     }
   }
-  const bool lqg = is_full_order(o.structure);
-  const char* parameter = lqg ? "kbw" : "omega*";
+  const bool hinf = o.structure == Structure::kHinf;
+  const bool lqg = is_full_order(o.structure) && !hinf;
+  const char* parameter = lqg ? "kbw" : hinf ? "w0S" : "omega*";
   if (!std::isfinite(best_s)) {
     throw InputError(at_field("--structure"),
                      fmt::format("no {} in the {} gives a stable loop with the known HF dynamics: reduce the "
                                  "delay/lags or use a slower structure",
-                                 parameter, lqg ? "range [1e-4, 1e3]" : "admissible range"));
+                                 parameter, lqg ? "range [1e-4, 1e3]" : hinf ? "range [0.05, 2r]" : "admissible range"));
   }
   throw InputError(at_field(o.w2 ? "--w2" : "--ms"),
                    fmt::format("no {} meets ||S|| <= {} and the tracking peak <= {}{}: the best achievable are "
@@ -194,7 +211,7 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Eva
                                : lqg ? " with robust stability and robust tracking (C7.13)"
                                      : " with robust performance",
                                best_s, best_t,
-                               lqg ? "kbw" : "omega*/omega_z", at));
+                               lqg ? "kbw" : hinf ? "w0S/omega_z" : "omega*/omega_z", at));
 }
 
 PlantScales scales(const NormalizedPlant& p) { return {p.omega_z, p.motor_inertia, p.r, p.zeta_z, p.zeta_p, p.a}; }
@@ -410,6 +427,27 @@ std::string pole_list(const std::vector<std::complex<double>>& poles) {
   return out;
 }
 
+/// The common end of the full-order paths (lqg, hinf): the summary stored, the loop analysed with
+/// the HF dynamics, notes when it is unstable (`knob`: what to change) or the controller itself
+/// is (`kind` names it), robustness with W2. Returns the loop for what follows.
+VelocityLoop finish_full_order(TuneResult& result, const TuneOptions& options, const SpecCheck& check,
+                               FullOrderSummary f, const std::string& knob, const std::string& kind) {
+  Controller& c = result.controller;
+  const ControllerTf tf = two_dof_form(f.compensator);
+  c.predicted = analyse(result.plant, tf);
+  if (!c.predicted.closed_loop_stable) c.notes.push_back("the loop with the known HF dynamics is UNSTABLE at this " + knob);
+  if (!f.controller_stable) {
+    c.notes.push_back(fmt::format("the {} is itself UNSTABLE (poles {}, normalized): the loop is stable only while "
+                                  "closed; switch it on in closed loop and keep the torque limit out of reach "
+                                  "(saturation opens the loop)",
+                                  kind, pole_list(f.controller_poles)));
+  }
+  c.full_order = std::move(f);
+  VelocityLoop loop(result.plant, tf);
+  if (check.w2) add_robustness(c, loop, *check.w2, options);
+  return loop;
+}
+
 /// The LQG path of tune(): kbw and kff, the compensator, its analysis and robustness.
 void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
   const NormalizedPlant& plant = result.plant;
@@ -436,20 +474,115 @@ void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& c
   f.compensator = d.compensator;
   f.controller_poles = d.controller_poles;
   f.controller_stable = d.controller_stable;
-  c.full_order = std::move(f);
-  const ControllerTf tf = two_dof_form(d.compensator);
-  c.predicted = analyse(plant, tf);
-  if (!c.predicted.closed_loop_stable)
-    c.notes.push_back("the loop with the known HF dynamics is UNSTABLE at this kbw: choose a larger one");
-  if (!d.controller_stable) {
-    c.notes.push_back(fmt::format("the LQG compensator is itself UNSTABLE (poles {}, normalized): the loop is stable "
-                                  "only while closed; switch it on in closed loop and keep the torque limit out of "
-                                  "reach (saturation opens the loop)",
-                                  pole_list(d.controller_poles)));
-  }
-  const VelocityLoop loop(plant, tf);
-  if (check.w2) add_robustness(c, loop, *check.w2, options);
+  const VelocityLoop loop = finish_full_order(result, options, check, std::move(f), "kbw: choose a larger one",
+                                              "LQG compensator");
   if (options.structure == Structure::kLqgP) add_position_loop(c, loop, check.w2, plant);
+}
+
+// ------------------------------------------------------------------------------------ hinf
+
+/// w0S candidates of the automatic search (normalized), and the w0T ladder of C7.14.
+constexpr double kOmega0sSlowest = 0.05, kOmega0sFastestPerR = 2.0;
+constexpr std::size_t kOmega0sPoints = 20;
+constexpr int kOmega0tSteps = 4;  // r, 2r, 4r, 8r
+
+/// The C7.14 design at (w0S, w0T) on the first mode, and its loop with the HF dynamics.
+struct HinfDesigner {
+  const NormalizedPlant& plant;
+  NormalizedPlant first_mode;
+  const TuneOptions& options;
+
+  [[nodiscard]] HinfDesign design(double omega_0s, double omega_0t) const {
+    VelocityHinfWeights w;
+    w.omega_0s = omega_0s;
+    w.omega_0t = omega_0t;
+    w.xi_v = options.xi_v;
+    w.ms = options.ms;
+    w.mt = options.mt;
+    return velocity_hinf(first_mode, w);
+  }
+  [[nodiscard]] VelocityLoop loop(const HinfDesign& d) const { return VelocityLoop(plant, two_dof_form(d.compensator)); }
+};
+
+/// One w0S: the first w0T of the ladder (or the given one) whose design meets the spec; the
+/// candidate of the last w0T tried when none does.
+struct HinfCandidate {
+  TuneResult::Candidate candidate;
+  double omega_0t = 0.0;
+};
+
+HinfCandidate evaluate_hinf(const HinfDesigner& h, const SpecCheck& check, double omega_0s) {
+  const double r = h.first_mode.r;
+  HinfCandidate out;
+  for (int step = 0; step < (h.options.omega_0t ? 1 : kOmega0tSteps); ++step) {
+    out.omega_0t = h.options.omega_0t.value_or(r * std::ldexp(1.0, step));
+    try {
+      out.candidate = check(omega_0s, h.loop(h.design(omega_0s, out.omega_0t)));
+    } catch (const std::domain_error&) {
+      out.candidate = {};  // no controller for these weights: an unstable candidate
+      out.candidate.omega_star = omega_0s;
+    }
+    if (out.candidate.feasible) break;
+  }
+  return out;
+}
+
+/// The hinf path of tune(): w0S and w0T, the compensator, its analysis and robustness.
+void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
+  const NormalizedPlant& plant = result.plant;
+  NormalizedPlant first = plant;  // the design plant: the first mode with the known HF dynamics
+  first.higher_modes.clear();
+  const HinfDesigner h{plant, first, options};
+  HinfSummary s;
+  s.xi_v = options.xi_v;
+  if (options.omega_0s) {
+    s.omega_0s = *options.omega_0s;
+    s.omega_0s_source = "given";
+  } else {
+    const auto evaluate = [&](double w) { return evaluate_hinf(h, check, w).candidate; };
+    // C7.14's loop: raise w0S while some w0T meets the spec; stop after two w0S in a row that no
+    // w0T of the ladder rescues (a faster pair only raises the peaks further).
+    bool met = false;
+    int misses = 0;
+    for (double w : core::log_space(kOmega0sSlowest, kOmega0sFastestPerR * plant.r, kOmega0sPoints)) {
+      result.scan.push_back(evaluate(w));
+      met = met || result.scan.back().feasible;
+      misses = result.scan.back().feasible ? 0 : misses + 1;
+      if (met && misses == 2) break;
+    }
+    TuneResult::Candidate chosen = choose(result.scan, evaluate);
+    if (!chosen.feasible) no_feasible_omega(result.scan, options);
+    // The w0T ladder makes the bandwidth jump along w0S: the upper end of the feasible range may
+    // beat the best scanned point even when its neighbour is feasible.
+    std::size_t last = 0;
+    for (std::size_t i = 0; i < result.scan.size(); ++i)
+      if (result.scan[i].feasible) last = i;
+    constexpr int kBoundarySteps = 8;  // scan points 1.3 apart: 0.1 % in w0S
+    if (last + 1 < result.scan.size())
+      refine_boundary(result.scan[last].omega_star, result.scan[last + 1].omega_star, evaluate, chosen, kBoundarySteps);
+    s.omega_0s = chosen.omega_star;
+    s.omega_0s_source = options.w2 ? "largest load bandwidth with ||S|| <= Ms, peak <= Mt and robust performance"
+                                   : "largest load bandwidth with ||S|| <= Ms and peak <= Mt";
+  }
+  s.omega_0t = options.omega_0t.value_or(evaluate_hinf(h, check, s.omega_0s).omega_0t);
+  HinfDesign d;
+  try {
+    d = h.design(s.omega_0s, s.omega_0t);
+  } catch (const std::domain_error& e) {
+    throw InputError(at_field(options.omega_0s ? "--omega-0s" : "--structure"),
+                     fmt::format("no H-infinity controller for w0S = {:.4g}, w0T = {:.4g} ({}); try other weights or "
+                                 "--omega-0s auto",
+                                 s.omega_0s, s.omega_0t, e.what()));
+  }
+  s.gamma_optimal = d.gamma_optimal;
+  s.gamma = d.gamma;
+  FullOrderSummary f;
+  f.hinf = s;
+  f.compensator = d.compensator;
+  f.controller_poles = d.controller_poles;
+  f.controller_stable = d.controller_stable;
+  (void)finish_full_order(result, options, check, std::move(f), "w0S: choose a smaller one", "H-infinity controller");
+  if (!result.advice.verdict.empty()) result.controller.notes.push_back(result.advice.verdict);
 }
 
 /// The cascade path of tune() (pi, pid, pi+p): ω*, the gains, their analysis and robustness.
@@ -524,7 +657,9 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   c.plant = scales(plant);
   c.design.ms = options.ms;
   c.design.mt = options.mt;
-  if (is_full_order(options.structure)) {
+  if (options.structure == Structure::kHinf) {
+    tune_hinf(result, options, check);
+  } else if (is_full_order(options.structure)) {
     tune_lqg(result, options, check);
   } else {
     tune_cascade(result, options, check);

@@ -62,6 +62,29 @@ TEST_F(Cli, TuneLqgAndSimulateIt) {
   EXPECT_NEAR(std::stod(cells[5]), 1.0, 0.005);
 }
 
+TEST_F(Cli, TuneHinfAndSimulateIt) {
+  // `tune --structure hinf` (C7.14) writes the controller: 8 states of the weighted plant, one of
+  // the preset's lag designed with, one integrator (K = K0/s); `simulate` runs it on the preset
+  // with its friction: the integral action balances the same 0.5 + 3.6 = 4.1 N m.
+  const Result t = run("tune table-5.1 --structure hinf -o hinf.json --report hinf.html");
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("structure hinf: mixed-sensitivity velocity loop (C7.14, 10 states): w0S = "), std::string::npos)
+      << t.out;
+  EXPECT_NE(t.out.find("gamma = "), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("verified by simulation"), std::string::npos) << t.out;
+  EXPECT_NE(slurp(path("hinf.html")).find("H∞ mixed-sensitivity design (C7.14"), std::string::npos);
+  const std::string json = slurp(path("hinf.json"));
+  EXPECT_NE(json.find("\"gamma_optimal\""), std::string::npos);
+  const Result r = run("simulate --controller hinf.json --duration 30 -o step.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string csv = slurp(path("step.csv"));
+  EXPECT_EQ(csv.rfind("# servotwin.drive-simulation/1 test=step structure=hinf", 0), 0U) << csv.substr(0, 80);
+  const auto cells = last_row(csv);
+  ASSERT_EQ(cells.size(), 14U);
+  EXPECT_NEAR(std::stod(cells[3]), 4.1, 0.02);
+  EXPECT_NEAR(std::stod(cells[5]), 1.0, 0.005);
+}
+
 TEST_F(Cli, TuneLqgPlusPAndSimulateAPositionStep) {
   // C7.13's cascade alternative: a P position loop over the LQG velocity loop. The position step on
   // table-5.1: the motor reaches the target (integral action in the velocity loop; the load sticks

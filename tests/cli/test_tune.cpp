@@ -78,8 +78,14 @@ TEST_F(Cli, TuneExplainsWhatItCannotDo) {
   r = run("tune no-such-plant");
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("presets"), std::string::npos) << r.err;
-  r = run("tune e26.json --structure hinf");
-  EXPECT_EQ(r.status, 2);  // not offered yet: a usage error listing the structures
+  r = run("tune e26.json --structure h2");
+  EXPECT_EQ(r.status, 2);  // not offered: a usage error listing the structures
+  r = run("tune e26.json --structure hinf --xi-v 0.5");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("--xi-v"), std::string::npos) << r.err;
+  r = run("tune e26.json --structure hinf --omega-0s fast");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("--omega-0s"), std::string::npos) << r.err;
   r = run("tune e26.json --structure lqg --kbw fast");
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("--kbw"), std::string::npos) << r.err;

@@ -24,20 +24,8 @@ const nlohmann::json& fixture() {
   return data;
 }
 
-/// Octave's jsonencode writes a 1x1 matrix as a number and a vector as a flat list.
 Eigen::MatrixXd matrix(const nlohmann::json& v, Eigen::Index rows, Eigen::Index cols) {
-  Eigen::MatrixXd m(rows, cols);
-  if (v.is_number()) {
-    m(0, 0) = v.get<double>();
-    return m;
-  }
-  if (!v.front().is_array()) {
-    for (Eigen::Index i = 0; i < rows * cols; ++i) m(rows == 1 ? 0 : i, rows == 1 ? i : 0) = v[static_cast<std::size_t>(i)];
-    return m;
-  }
-  for (Eigen::Index i = 0; i < rows; ++i)
-    for (Eigen::Index j = 0; j < cols; ++j) m(i, j) = v[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
-  return m;
+  return test_support::octave_matrix(v, rows, cols);
 }
 
 StateSpace system_of(const nlohmann::json& c) {

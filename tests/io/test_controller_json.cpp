@@ -215,6 +215,15 @@ void expect_round_trip(const Controller& c, const Controller& b) {
     EXPECT_EQ(f.compensator.D, g.compensator.D);
     EXPECT_EQ(f.controller_poles, g.controller_poles);
     EXPECT_EQ(f.controller_stable, g.controller_stable);
+    ASSERT_EQ(f.hinf.has_value(), g.hinf.has_value());
+    if (g.hinf) {
+      EXPECT_EQ(f.hinf->omega_0s, g.hinf->omega_0s);
+      EXPECT_EQ(f.hinf->omega_0t, g.hinf->omega_0t);
+      EXPECT_EQ(f.hinf->xi_v, g.hinf->xi_v);
+      EXPECT_EQ(f.hinf->gamma_optimal, g.hinf->gamma_optimal);
+      EXPECT_EQ(f.hinf->gamma, g.hinf->gamma);
+      EXPECT_EQ(f.hinf->omega_0s_source, g.hinf->omega_0s_source);
+    }
   }
   ASSERT_EQ(b.discrete.has_value(), c.discrete.has_value());
   if (c.discrete) {
@@ -589,7 +598,7 @@ TEST_F(ControllerJsonErrors, SamplePeriodAndPrewarp) {
 }
 
 TEST_F(ControllerJsonErrors, StructureAndLoop) {
-  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"pi+p\", \"lqg\" or \"lqg+p\"");
+  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"lqg\", \"lqg+p\" or \"hinf\"");
   expect(with([](auto& c) { c["position"]["kpp"] = 1.0; c["position"]["kpp_normalized"] = 1.0; }, Structure::kPiP),
          "position.kpp", "de-normalized");
   expect(with([](auto& c) { c["structure"] = "lqg"; }), "gains", "expected null for an \"lqg\" controller");
@@ -650,6 +659,38 @@ TEST_F(ControllerJsonErrors, LqgDocuments) {
   expect(edited([](auto& c) { c["design"]["omega_star"] = 0.5; }), "design.omega_star", "expected null");
   expect(edited([](auto& c) { c["gains"] = c["state_space"]; }), "gains", "expected null");
   expect(with([](auto& c) { c["lqg"] = {{"kbw", 1.0}}; }), "lqg", "only lqg and lqg+p controllers");
+}
+
+TEST(ControllerJsonRoundTrip, HinfFromTheTuner) {
+  const Controller c = full_order_controller(Structure::kHinf);
+  ASSERT_TRUE(c.full_order && c.full_order->hinf);
+  const nlohmann::json j = controller_to_json(c, "two_mass.json");
+  EXPECT_TRUE(j["lqg"].is_null());
+  EXPECT_TRUE(j["gains"].is_null());
+  EXPECT_EQ(j["hinf"]["compensator"]["A"].size(), 9U);
+  EXPECT_EQ(j["structure"], "hinf");
+  EXPECT_EQ(j["loop"], "velocity");
+  const LoadedController back = parse_controller_json(j.dump(), "hinf.json");
+  expect_round_trip(c, back.controller);
+}
+
+TEST_F(ControllerJsonErrors, HinfDocuments) {
+  static const nlohmann::json hinf = controller_to_json(full_order_controller(Structure::kHinf), "p.json");
+  const auto edited = [](auto edit) {
+    nlohmann::json copy = hinf;
+    edit(copy);
+    return error_of(copy.dump());
+  };
+  EXPECT_EQ(edited([](auto&) {}).message, "no error");
+  expect(edited([](auto& c) { c["hinf"] = nullptr; }), "hinf", "needs its compensator");
+  expect(edited([](auto& c) { c["hinf"]["gamma"] = 0.5 * c["hinf"]["gamma_optimal"].template get<double>(); }),
+         "hinf.gamma", "below gamma_optimal");
+  expect(edited([](auto& c) { c["hinf"]["omega_0s"] = -1.0; }), "hinf.omega_0s", "> 0");
+  expect(edited([](auto& c) { c["hinf"]["controller_poles"][0][0] = 99.0; }), "hinf.controller_poles[0]",
+         "not an eigenvalue");
+  expect(edited([](auto& c) { c["hinf"]["compensator"]["B"][1][1] = 7.0; }), "state_space", "does not realize");
+  expect(edited([](auto& c) { c["lqg"] = c["hinf"]; }), "lqg", "only lqg and lqg+p controllers");
+  expect(with([](auto& c) { c["hinf"] = {{"omega_0s", 1.0}}; }), "hinf", "only hinf controllers");
 }
 
 TEST_F(ControllerJsonErrors, PlantDesignAndDerivedMembers) {

@@ -399,8 +399,8 @@ TEST(TuningReport, LqgShowsItsDesignAndTheCompensatorsStability) {
 }
 
 TEST(ComparisonReport, OneTableAndEveryStructureInEachChart) {
-  // table-5.1 (r = 3): PI, PID and LQG all design; the table's bandwidths are the designs' own in
-  // Hz (× ωz/2π, ωz = 1 rad/s here) and the ratios to the PI; each chart overlays the three.
+  // table-5.1 (r = 3): PI, PID, LQG and H∞ all design; the table's bandwidths are the designs' own
+  // in Hz (× ωz/2π, ωz = 1 rad/s here) and the ratios to the PI; each chart overlays the four.
   const std::vector<tuning::StructureComparison> c = tuning::compare_structures(table_5_1_model(), {});
   const Document doc = comparison_report(c, {"table-5.1"});
   for (const Section& s : doc.sections)
@@ -409,9 +409,9 @@ TEST(ComparisonReport, OneTableAndEveryStructureInEachChart) {
         for (double y : series.y) EXPECT_TRUE(std::isfinite(y)) << chart.title << " / " << series.label;
   expect_html_has_every_chart(doc, 3'000'000);
   const Table& t = must(find_table(must(find_section(doc, "Comparison")), "Structures tuned to the same spec"));
-  ASSERT_EQ(t.rows.size(), 3U);
+  ASSERT_EQ(t.rows.size(), 4U);
   const double hz = 1.0 / kTwoPi;
-  for (std::size_t k = 0; k < 3; ++k) {
+  for (std::size_t k = 0; k < 4; ++k) {
     const tuning::LoopIndices& i = c[k].result->controller.predicted;
     EXPECT_EQ(t.rows[k][2], num(i.bandwidth_load * hz, 4));
     EXPECT_EQ(t.rows[k][3], "×" + num(i.bandwidth_load / c[0].result->controller.predicted.bandwidth_load, 3));
@@ -421,6 +421,7 @@ TEST(ComparisonReport, OneTableAndEveryStructureInEachChart) {
   EXPECT_NE(find_series(tracking, "pi"), nullptr);
   EXPECT_NE(find_series(tracking, "pid"), nullptr);
   EXPECT_NE(find_series(tracking, "lqg"), nullptr);
+  EXPECT_NE(find_series(tracking, "hinf"), nullptr);
   const Chart& steps = must(find_chart(must(find_section(doc, "Time responses (linear)")),
                                        "Load velocity after a unit velocity step"));
   for (const Series& series : steps.series) EXPECT_NEAR(series.y.back(), 1.0, 1e-3) << series.label;
@@ -455,9 +456,9 @@ TEST(ComparisonReport, SimulationsOnThePlantAreOneSectionPerTest) {
   for (const char* title : {"Simulation on the plant: step", "Simulation on the plant: load-step"}) {
     const Section& s = must(find_section(doc, title));
     ASSERT_EQ(s.tables.size(), 1U);
-    EXPECT_EQ(s.tables[0].rows.size(), 3U);
+    EXPECT_EQ(s.tables[0].rows.size(), 4U);
     ASSERT_EQ(s.charts.size(), 2U);
-    ASSERT_EQ(s.charts[0].series.size(), 3U);
+    ASSERT_EQ(s.charts[0].series.size(), 4U);
     EXPECT_EQ(s.charts[0].series[2].label, "lqg");
   }
   const Section& step = must(find_section(doc, "Simulation on the plant: step"));
@@ -471,7 +472,7 @@ TEST(ComparisonReport, AFailedStructureIsARowWithItsReason) {
       tuning::compare_structures(two_mass_model(1.5, 0.01, kTwoPi * 20.0, 0.01), {});
   const Document doc = comparison_report(c);
   const Table& t = must(find_table(must(find_section(doc, "Comparison")), "Structures tuned to the same spec"));
-  ASSERT_EQ(t.rows.size(), 3U);
+  ASSERT_EQ(t.rows.size(), 4U);
   EXPECT_EQ(t.rows[1][0], "pid");
   EXPECT_EQ(t.rows[1][1].rfind("not tuned: no omega* meets", 0), 0U) << t.rows[1][1];
   EXPECT_THROW((void)comparison_report({c[1]}), core::InputError);

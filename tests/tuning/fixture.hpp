@@ -15,10 +15,22 @@
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/polynomial.hpp"
 #include "servotwin/core/transfer_function.hpp"
+#include "servotwin/fit/plant_model.hpp"
 
 namespace servotwin::tuning::test {
 
 inline constexpr double kSqrtHalf = std::numbers::sqrt2 / 2.0;
+
+/// A velocity model K (s² + 2ζz ωz s + ωz²)/(s (s² + 2ζ ωn s + ωn²)) with ωn = r ωz, ζ = r ζz
+/// (frictionless two-mass), K = 1/Im; by default a 40 Hz antiresonance and Im = 4e-3.
+inline fit::PlantModel two_mass_model(double r, double zeta_z, double omega_z = 2.0 * std::numbers::pi * 40.0,
+                                      double im = 4e-3) {
+  fit::PlantModel m;
+  m.rigid = fit::RigidKind::kIntegrator;
+  m.gain = 1.0 / im;
+  m.modes = {{{omega_z, zeta_z}, {r * omega_z, r * zeta_z}}};
+  return m;
+}
 
 /// tests/data/tuning/tuning_reference.json (parsed once).
 inline const nlohmann::json& reference() {

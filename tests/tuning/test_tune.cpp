@@ -14,15 +14,7 @@
 namespace servotwin::tuning {
 namespace {
 
-/// A velocity model K (s² + 2ζz ωz s + ωz²)/(s (s² + 2ζ ωn s + ωn²)) with ωn = r ωz, ζ = r ζz
-/// (frictionless two-mass), K = 1/Im.
-fit::PlantModel two_mass_model(double r, double zeta_z, double omega_z, double im) {
-  fit::PlantModel m;
-  m.rigid = fit::RigidKind::kIntegrator;
-  m.gain = 1.0 / im;
-  m.modes = {{{omega_z, zeta_z}, {r * omega_z, r * zeta_z}}};
-  return m;
-}
+using test::two_mass_model;
 
 TEST(Tune, GivenOmegaStarReproducesE26AndDenormalizes) {
   const double wz = 2.0 * std::numbers::pi * 12.0, im = 2.5e-3;

@@ -23,13 +23,9 @@ namespace {
 // A namespace of its own: the module's test files are compiled as one translation unit.
 namespace tune_lqg_test {
 
-/// The frictionless two-mass velocity model of ratio r in physical units (as test_tune.cpp).
+/// The frictionless two-mass velocity model of ratio r in physical units (40 Hz, Im = 4 g m²).
 fit::PlantModel model(double r, double zeta_z, double omega_z = 2.0 * std::numbers::pi * 40.0, double im = 4e-3) {
-  fit::PlantModel m;
-  m.rigid = fit::RigidKind::kIntegrator;
-  m.gain = 1.0 / im;
-  m.modes = {{{omega_z, zeta_z}, {r * omega_z, r * zeta_z}}};
-  return m;
+  return test::two_mass_model(r, zeta_z, omega_z, im);
 }
 
 TuneOptions lqg_options() {

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The structure comparison of catalog C7.15 across resonance ratios: the normalized frictionless
 # two-mass plant (antiresonance 1 rad/s, Im = 1, zeta_z = 0.01, resonance damping r*zeta_z) for
-# r in [1.1, 8], each compared by `servotwin tune compare` (PI, PID with r-bar = 2, LQG) at
+# r in [1.1, 8], each compared by `servotwin tune compare` (PI, PID with r-bar = 2, LQG, H-infinity) at
 # Ms = Mt = 1.5. Prints one table per r; docs/controller-tuning-study.md quotes it.
 #   tools/studies/c7_15_comparison.sh [SERVOTWIN]
 set -euo pipefail

@@ -34,6 +34,18 @@ struct CareReport {
 Eigen::MatrixXd solve_care(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q,
                            const Eigen::MatrixXd& R, CareReport* report = nullptr);
 
+/// The stabilizing solution X = X^T of A^T X + X A - X G X + Q = 0 (A - G X Hurwitz) for symmetric
+/// G and Q of any inertia: the Riccati equations of H-infinity synthesis, where G = B R^-1 B^T
+/// with an indefinite R (core/hinf.hpp). Same method and diagnostics as solve_care. Throws
+/// std::invalid_argument for shapes, non-finite or non-symmetric G, Q; std::domain_error when the
+/// Hamiltonian [[A, -G], [-Q, -A^T]] has eigenvalues on the imaginary axis or its stable
+/// invariant subspace is not a graph [I; X] (no stabilizing solution), and when the relative
+/// residual exceeds `residual_tolerance` (in [1e-14, 1e-2]; solve_care uses 1e-8). H-infinity
+/// synthesis passes a looser one: near the optimum its equations are ill-conditioned, and it
+/// checks the closed loop the solution leads to instead.
+Eigen::MatrixXd solve_care_indefinite(const Eigen::MatrixXd& A, const Eigen::MatrixXd& G, const Eigen::MatrixXd& Q,
+                                      CareReport* report = nullptr, double residual_tolerance = 1e-8);
+
 /// Filter (Kalman–Bucy) form: the stabilizing Y = Y^T of
 ///   A Y + Y A^T - Y C^T V^-1 C Y + W = 0,
 /// so that A - L C with L = Y C^T V^-1 is Hurwitz. W (n x n) is the process-noise intensity

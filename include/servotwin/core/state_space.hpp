@@ -130,6 +130,12 @@ StateSpace append(const StateSpace& a, const StateSpace& b);
 /// invertible, else std::invalid_argument ("algebraic loop").
 StateSpace lft_lower(const StateSpace& p, const StateSpace& k, Eigen::Index ny, Eigen::Index nu);
 
+/// The same system in balanced state coordinates: a diagonal similarity by powers of two (exact in
+/// floating point) that gives A's rows and columns comparable norms (A_b = T^-1 A T, B_b = T^-1 B,
+/// C_b = C T; the transfer matrix is unchanged). For realizations whose entries span many decades
+/// (synthesized controllers) before they are discretized or written out.
+StateSpace balance_states(const StateSpace& sys);
+
 /// Static gain G(0) = D - C A^-1 B (outputs x inputs), computed on the balanced A. Throws
 /// std::domain_error when A is singular to working precision (a pole at s = 0: the gain is
 /// infinite in the channels that see the integrator and undefined as a matrix); use

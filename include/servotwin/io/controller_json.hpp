@@ -3,12 +3,12 @@
 /// The tuned controller file "servotwin.controller/1" (written by `servotwin tune`, read by the
 /// simulation and report commands):
 ///
-///     {"format": "servotwin.controller/1", "structure": "pi"|"pid"|"pi+p"|"lqg",
+///     {"format": "servotwin.controller/1", "structure": "pi"|"pid"|"pi+p"|"lqg"|"lqg+p"|"hinf",
 ///      "loop": "velocity"|"position" (position iff pi+p), "feedback": "motor",
 ///      "plant": {"source", "omega_z_hz", "motor_inertia", "r", "zeta_z", "zeta_p", "a"},
 ///      "gains": {"kp", "ki", "kd", "tau", "wp", "wd", "kpp"}        (physical; kpp null unless pi+p;
-///                                                                   null for lqg)
-///      "normalized": {the same members, normalized} (null for lqg),
+///                                                                   null for lqg, lqg+p, hinf)
+///      "normalized": {the same members, normalized} (null for lqg, lqg+p, hinf),
 ///      "state_space": {"inputs": ["velocity_reference", "motor_velocity"], "output": "torque",
 ///                      "A", "B", "C", "D"}                            (physical, continuous)
 ///      "discrete": {"ts", "method": "tustin", "prewarp_hz" (or null), "A", "B", "C", "D"} or null,
@@ -21,7 +21,9 @@
 ///      "position": {...} (pi+p) or null,
 ///      "lqg": {"kbw", "kbw_source", "feedforward", "feedforward_source", the weights of
 ///              tuning::VelocityLqgOptions, "controller_stable", "controller_poles",
-///              "compensator": {as "state_space", normalized}} (lqg) or null (may be absent),
+///              "compensator": {as "state_space", normalized}} (lqg, lqg+p) or null (may be absent),
+///      "hinf": {"omega_0s", "omega_0s_source", "omega_0t", "xi_v", "gamma_optimal", "gamma",
+///               "controller_stable", "controller_poles", "compensator"} (hinf) or null (may be absent),
 ///      "notes": ["..."]}
 ///
 /// Matrices are arrays of rows. Non-finite indices are written as the strings "inf" and "-inf"
@@ -33,7 +35,7 @@
 /// loop matches the structure, that the physical gains are the normalized ones de-normalized with
 /// the plant scales (tuning::to_physical, Kpp = Kpp_n·ωz; relative 1e-6), that the state spaces
 /// realize the controller of the gains (tuning::controller_state_space and
-/// tuning::discretize_controller, compared as frequency responses, relative 1e-6; for lqg the
+/// tuning::discretize_controller, compared as frequency responses, relative 1e-6; for lqg and hinf the
 /// compensator de-normalized, with its listed poles the eigenvalues of its A and its stability
 /// flag theirs) and that the
 /// derived members (`_hz`, `_s`) agree with the normalized ones. So a hand-edited file cannot

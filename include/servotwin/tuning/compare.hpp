@@ -25,7 +25,7 @@ struct StructureComparison {
   std::string failure;               ///< the tuner's message then (core::InputError::reason())
 };
 
-/// The velocity-loop structures of C7.15 that the tuner offers: pi, pid, lqg.
+/// The velocity-loop structures of C7.15 that the tuner offers: pi, pid, lqg, hinf.
 [[nodiscard]] std::vector<Structure> comparison_structures();
 
 /// Tunes each of `structures` with `options` (its structure replaced; allow_negative_kd set for

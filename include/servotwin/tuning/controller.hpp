@@ -11,6 +11,8 @@
 ///   lqg   the full-order velocity LQG compensator of C7.13 (inputs [ω*, ωm], 5 states)
 ///   lqg+p a P position loop over the LQG velocity loop (C7.13's more robust alternative to the
 ///         full position LQG)
+///   hinf  the H-infinity mixed-sensitivity velocity controller of C7.14 (1-DoF, K0/s; inputs
+///         [ω*, ωm], 9 states)
 
 #include <optional>
 #include <string>
@@ -25,15 +27,15 @@
 namespace servotwin::tuning {
 
 /// Controller structure offered by the tuner.
-enum class Structure { kPi, kPid, kPiP, kLqg, kLqgP };
+enum class Structure { kPi, kPid, kPiP, kLqg, kLqgP, kHinf };
 
-/// A structure whose velocity controller is a general state space (no PID gains): lqg, lqg+p.
+/// A structure whose velocity controller is a general state space (no PID gains): lqg, lqg+p, hinf.
 [[nodiscard]] bool is_full_order(Structure structure) noexcept;
 
 /// A structure with a P position loop over its velocity loop: pi+p, lqg+p.
 [[nodiscard]] bool has_position_loop(Structure structure) noexcept;
 
-/// "pi", "pid", "pi+p", "lqg", "lqg+p".
+/// "pi", "pid", "pi+p", "lqg", "lqg+p", "hinf".
 [[nodiscard]] std::string to_string(Structure structure);
 /// Inverse of to_string; std::nullopt for an unknown name.
 [[nodiscard]] std::optional<Structure> structure_from_string(const std::string& name);
@@ -65,9 +67,20 @@ struct RobustnessSummary {
   std::optional<double> rp_tracking;
 };
 
-/// A full-order (LQG) design, normalized units (C7.13).
+/// The weights and optimum of an H-infinity design (C7.14), normalized frequencies.
+struct HinfSummary {
+  double omega_0s = 0.0;           ///< w0S: dominant closed-loop pole pair
+  double omega_0t = 0.0;           ///< w0T: bandwidth cap
+  double xi_v = 0.0;               ///< damping of the relocated resonant pair
+  double gamma_optimal = 0.0;      ///< optimal gamma of the weighted problem
+  double gamma = 0.0;              ///< gamma of the controller (gamma_optimal times the backoff)
+  std::string omega_0s_source;     ///< "given", or what limited the automatic w0S
+};
+
+/// A full-order (LQG or H-infinity) design, normalized units (C7.13, C7.14).
 struct FullOrderSummary {
-  VelocityLqgOptions weights;         ///< the weights used, with the chosen kbw and kff
+  VelocityLqgOptions weights;         ///< lqg: the weights used, with the chosen kbw and kff (unused for hinf)
+  std::optional<HinfSummary> hinf;    ///< hinf: the weights and gamma (absent for lqg)
   std::string kbw_source;             ///< "given", or what limited the automatic kbw
   std::string feedforward_source;     ///< "given", "none", or what limited the automatic kff
   core::StateSpace compensator;       ///< normalized: inputs [ω*, ωm], output u (time by ωz, torque by Im ωz)

@@ -11,6 +11,13 @@
 /// or the virtual-inertia PID (C7.5), add the P position loop (C7.10) for pi+p, and analyse the
 /// result (indices, margins, time responses).
 ///
+/// hinf: the mixed-sensitivity controller of C7.14 (hinf.hpp) on the first mode's design plant
+/// with the known HF dynamics (the delay as a Padé approximant), W1 = 1/Ms and W2's 1/Mt from the
+/// options; w0S scanned from 0.05 to 2r on a log grid, each candidate with the first w0T of r, 2r,
+/// 4r, 8r that meets the spec, the best load bandwidth chosen, the boundaries next to it and at the
+/// upper end of the feasible w0S refined by bisection; analysed with the exact delay and the
+/// higher modes.
+///
 /// lqg: the velocity LQG of C7.13 on the first mode's two-mass realization (with its viscous
 /// friction); kbw scanned from slow (1e3) to fast (1e-4) on a log grid, each candidate with its
 /// largest feedforward kff within the spec (doubling, then bisection), the best load bandwidth
@@ -24,6 +31,7 @@
 #include "servotwin/core/transfer_function.hpp"
 #include "servotwin/fit/plant_model.hpp"
 #include "servotwin/tuning/controller.hpp"
+#include "servotwin/tuning/hinf.hpp"
 #include "servotwin/tuning/loop_analysis.hpp"
 #include "servotwin/tuning/lqg.hpp"
 #include "servotwin/tuning/normalized_plant.hpp"
@@ -59,6 +67,12 @@ struct TuneOptions {
   /// lqg with automatic kbw: when no kbw meets the spec, raise lqg.measurement_noise by decades (up
   /// to 10⁴ times) and search again (a note says so); false: fail with the tuner's message.
   bool raise_measurement_noise = true;
+  /// hinf: w0S (normalized); std::nullopt: the automatic search of C7.14 (the largest load
+  /// bandwidth within the spec of automatic ω*).
+  std::optional<double> omega_0s;
+  /// hinf: w0T (normalized); std::nullopt: r, raised to 2r, 4r, 8r while the spec fails (C7.14).
+  std::optional<double> omega_0t;
+  double xi_v = 0.8;  ///< hinf: damping of the relocated resonant pair, [0.707, 1]
 };
 
 /// Everything the tuner found, for the CLI summary, the controller file and the report.

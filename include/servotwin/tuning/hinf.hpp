@@ -1,0 +1,72 @@
+#pragma once
+/// \file
+/// H-infinity mixed-sensitivity velocity controller for the normalized two-mass plant with the
+/// pole-relocating weight V of the dissertation (catalog C7.14), solved by core::hinf_synthesis.
+///
+/// Modified mixed sensitivity (Kwakernaak): minimize gamma = sup_w sqrt(|W1 S V|^2 + |W2 U V|^2)
+/// on the extended plant Pe = Pm/s (integral action; the controller is K = K0/s), with
+///   W1 = 1/Ms,
+///   W2 = (1/Mt) (s + w0T)^2 (s + r)^2 / [(s + w0S)^2 (s^2 + 2 xi_v r s + r^2) (w0T r)^2],
+///   V  = (s + w0S)^2 (s^2 + 2 xi_v r s + r^2) / den(Pe).
+/// V's denominator is Pe's (the open-loop poles: printed s^2 (s^2 + 2 zeta_z r^2 s + r^2) for the
+/// frictionless plant, s (s + a)(s^2 + 2 zeta_p r s + r^2) with friction), its numerator the poles
+/// the loop should get: the controller cannot cancel the lightly damped pair (that would make a
+/// notch and lose active damping) and moves it to damping xi_v at r. w0S sets the dominant pole
+/// pair (performance), w0T caps the bandwidth (robustness).
+///
+/// Generalized plant (states: the shared realization of [V Pe], then W2's), inputs [w, u0],
+/// outputs [z1, z2, e]: z1 = W1 (Pe u0 + V w), z2 = W2 u0, e = -(Pe u0 + V w); u0 = K0 e.
+/// V and Pe share one realization of den(Pe), so the disturbance model's integrators are the
+/// plant's own (stabilizable) and D21 = 1: the disturbance-feedforward case, Y = 0.
+///
+/// The design model is the first mode's two-mass plant Pm (normalized_plant.hpp) without higher
+/// modes, times the plant's known HF dynamics (hf: current lag, lag, measurement filter, and the
+/// delay as its first-order Padé approximant (1 - sT/2)/(1 + sT/2)); V's numerator gets the same
+/// extra poles, so its shape is unchanged. The tuner evaluates the loop with the exact delay and
+/// the higher modes.
+
+#include <complex>
+#include <optional>
+#include <vector>
+
+#include "servotwin/core/state_space.hpp"
+#include "servotwin/tuning/normalized_plant.hpp"
+
+namespace servotwin::tuning {
+
+/// C7.14's velocity weights (normalized frequencies).
+struct VelocityHinfWeights {
+  double omega_0s = 0.5;            ///< w0S: dominant closed-loop pole pair (> 0)
+  std::optional<double> omega_0t;   ///< w0T: bandwidth cap (> 0); default r
+  double xi_v = 0.8;                ///< damping of the relocated resonant pair, in [sqrt(2)/2, 1] (0.7 accepted)
+  double ms = 1.5;                  ///< W1 = 1/Ms
+  double mt = 1.5;                  ///< the 1/Mt of W2
+  double backoff = 1.01;            ///< controller at gamma_opt * backoff (core::HinfOptions)
+};
+
+/// A designed H-infinity velocity controller (normalized units).
+struct HinfDesign {
+  core::StateSpace generalized_plant;  ///< inputs [w, u0], outputs [z1, z2, e]
+  core::StateSpace k0;                 ///< controller of Pe: e -> u0
+  core::StateSpace compensator;        ///< K = K0/s as inputs [w*, wm], output torque (1-DoF: u = K (w* - wm))
+  double gamma_optimal = 0.0;          ///< optimal gamma (core::hinf_synthesis, relative tolerance 1e-4)
+  double gamma = 0.0;                  ///< gamma of the returned controller (gamma_optimal * backoff)
+  double closed_loop_norm = 0.0;       ///< ||F_l(P, K0)||_inf
+  double omega_0t = 0.0;               ///< the w0T used
+  std::vector<std::complex<double>> controller_poles;  ///< eig of the compensator (one integrator at 0)
+  bool controller_stable = false;      ///< stable except the integrator (stable_except_integrator)
+};
+
+/// The generalized plant above for the first mode of `plant` with its HF dynamics (higher modes
+/// left out; 8 states plus one per HF factor). core::InputError (field "omega_0s", "omega_0t", "xi_v", "ms", "mt") for weights out of
+/// range; plant checks as in normalized_two_mass().
+[[nodiscard]] core::StateSpace velocity_mixed_sensitivity_plant(const NormalizedPlant& plant,
+                                                                const VelocityHinfWeights& weights);
+
+/// The C7.14 velocity design: the generalized plant, core::hinf_synthesis (relative tolerance
+/// 1e-4, the weights' backoff), K = K0/s in the tuner's two-input form. Throws core::InputError as
+/// velocity_mixed_sensitivity_plant and for a backoff outside [1, 10]; std::domain_error when the
+/// synthesis finds no controller (not expected for valid weights: the problem is always solvable).
+[[nodiscard]] HinfDesign velocity_hinf(const NormalizedPlant& plant, const VelocityHinfWeights& weights);
+
+}  // namespace servotwin::tuning

@@ -1,0 +1,155 @@
+// H-infinity mixed-sensitivity velocity design (C7.14). References: GNU Octave's control package in
+// tests/data/core/hinf_reference.json (tools/reference/hinf_reference.m): the generalized plant
+// built there from transfer-function objects (Octave's own realizations), its optimal gamma
+// (bisection over hinfsyn SUBOPTIMAL = SLICOT SB10FD) and the central controller at a fixed gamma;
+// and the mixed-sensitivity bound |S| <= gamma / |W1 V| that any solution must satisfy.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <string>
+
+#include "json_fixture.hpp"
+#include "servotwin/core/error.hpp"
+#include "servotwin/core/hinf.hpp"
+#include "servotwin/tuning/hinf.hpp"
+#include "servotwin/tuning/lqg.hpp"
+#include "servotwin/tuning/velocity_loop.hpp"
+
+namespace servotwin::tuning {
+namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace hinf_test {
+
+const nlohmann::json& reference() {
+  static const nlohmann::json j = test_support::read_json_fixture("core/hinf_reference.json", "hinf_reference.m");
+  return j;
+}
+
+struct VelocityCase {
+  std::string name;
+  NormalizedPlant plant;
+  VelocityHinfWeights weights;
+  core::StateSpace octave_plant;
+  double gamma_optimal = 0.0, gamma_suboptimal = 0.0;
+  nlohmann::json raw;
+};
+
+std::vector<VelocityCase> velocity_cases() {
+  std::vector<VelocityCase> out;
+  for (const auto& c : reference()["cases"]) {
+    if (c["name"].get<std::string>().rfind("velocity", 0) != 0) continue;
+    const auto& w = c["weights"];
+    VelocityCase v;
+    v.name = c["name"].get<std::string>();
+    v.plant = normalized_two_mass(w["r"].get<double>(), w["zz"].get<double>(), w["zp"].get<double>(), w["a"].get<double>());
+    v.weights.omega_0s = w["w0S"].get<double>();
+    v.weights.omega_0t = w["w0T"].get<double>();
+    v.weights.xi_v = w["xv"].get<double>();
+    v.weights.ms = w["Ms"].get<double>();
+    v.weights.mt = w["Mt"].get<double>();
+    const auto n = c["states"].get<Eigen::Index>();
+    v.octave_plant = {test_support::octave_matrix(c["A"], n, n), test_support::octave_matrix(c["B"], n, 2),
+                      test_support::octave_matrix(c["C"], 3, n), test_support::octave_matrix(c["D"], 3, 2)};
+    v.gamma_optimal = c["gamma_optimal"].get<double>();
+    v.gamma_suboptimal = c["gamma_suboptimal"].get<double>();
+    v.raw = c;
+    out.push_back(v);
+  }
+  return out;
+}
+
+TEST(VelocityHinf, GeneralizedPlantEqualsOctavesConstruction) {
+  const auto cases = velocity_cases();
+  ASSERT_EQ(cases.size(), 3u);
+  for (const VelocityCase& c : cases) {
+    SCOPED_TRACE(c.name);
+    const core::StateSpace p = velocity_mixed_sensitivity_plant(c.plant, c.weights);
+    ASSERT_EQ(p.states(), 8);
+    for (const double w : {0.01, 0.1, 0.5, 1.0, 1.9, 2.0, 4.0, 10.0, 100.0}) {
+      const Eigen::MatrixXcd expected = core::frequency_response(c.octave_plant, w);
+      const Eigen::MatrixXcd got = core::frequency_response(p, w);
+      EXPECT_LT((got - expected).norm(), 1e-9 * expected.norm()) << "omega " << w;
+    }
+  }
+}
+
+TEST(VelocityHinf, OptimalGammaAndControllerMatchOctave) {
+  for (const VelocityCase& c : velocity_cases()) {
+    SCOPED_TRACE(c.name);
+    const HinfDesign d = velocity_hinf(c.plant, c.weights);
+    // Tolerance 1e-4 of the synthesis; ours may lie a little below SLICOT's (core test_hinf).
+    EXPECT_LE(d.gamma_optimal, c.gamma_optimal * (1.0 + 1.1e-4));
+    EXPECT_GE(d.gamma_optimal, c.gamma_optimal * (1.0 - 1e-4));
+    EXPECT_NEAR(d.gamma, 1.01 * d.gamma_optimal, 1e-12);
+    EXPECT_LT(d.closed_loop_norm, d.gamma * (1.0 + 1e-6));
+
+    // At Octave's fixed gamma the central controller K0 is Octave's.
+    VelocityHinfWeights at_fixed = c.weights;
+    const auto k0 = core::hinf_central_controller(velocity_mixed_sensitivity_plant(c.plant, at_fixed), 1, 1,
+                                                  c.gamma_suboptimal);
+    ASSERT_TRUE(k0.has_value());
+    const auto& omega = c.raw["omega"];
+    for (std::size_t i = 0; i < omega.size(); ++i) {
+      const std::complex<double> expected(c.raw["K_re"][i].get<double>(), c.raw["K_im"][i].get<double>());
+      EXPECT_LT(std::abs(core::frequency_response(k0->controller, omega[i].get<double>(), 0, 0) - expected),
+                1e-6 * std::abs(expected));
+    }
+  }
+}
+
+// The defining property of the design: |W1 S V| <= gamma at every frequency (the first row of the
+// closed loop), i.e. |S| <= gamma Ms / |V|; checked on the loop the tuner analyses (the compensator
+// K0/s in its 2-DoF form), so the integrator and the input convention are covered too.
+TEST(VelocityHinf, SensitivityRespectsTheMixedSensitivityBound) {
+  for (const VelocityCase& c : velocity_cases()) {
+    SCOPED_TRACE(c.name);
+    const HinfDesign d = velocity_hinf(c.plant, c.weights);
+    const VelocityLoop loop(c.plant, two_dof_form(d.compensator), false);
+    ASSERT_TRUE(loop.stable());
+    const double r = c.plant.r;
+    const double w0s = c.weights.omega_0s, xv = c.weights.xi_v;
+    for (const double w : core::log_space(1e-2, 1e2, 61)) {
+      const std::complex<double> s(0.0, w);
+      const std::complex<double> target = (s + w0s) * (s + w0s) * (s * s + 2.0 * xv * r * s + r * r);
+      const std::complex<double> den =
+          s * (s + c.plant.a) * (s * s + 2.0 * c.plant.zeta_p * r * s + r * r);
+      const double bound = d.gamma * c.weights.ms * std::abs(den) / std::abs(target);
+      EXPECT_LE(std::abs(loop.sensitivity(w)), bound * (1.0 + 1e-6)) << "omega " << w;
+    }
+    EXPECT_TRUE(std::abs(d.controller_poles.front()) < 1e-9 * std::abs(d.controller_poles.back()))
+        << "K = K0/s has its integrator";
+  }
+}
+
+TEST(VelocityHinf, RejectsWeightsOutOfRange) {
+  const NormalizedPlant plant = normalized_two_mass(3.0, 0.01);
+  const auto field_of = [&](VelocityHinfWeights w) {
+    try {
+      (void)velocity_hinf(plant, w);
+    } catch (const core::InputError& e) {
+      return e.where().field;
+    }
+    return std::string("no error");
+  };
+  VelocityHinfWeights w;
+  w.xi_v = 0.5;
+  EXPECT_EQ(field_of(w), "xi_v");
+  w = {};
+  w.omega_0s = 0.0;
+  EXPECT_EQ(field_of(w), "omega_0s");
+  w = {};
+  w.omega_0t = -1.0;
+  EXPECT_EQ(field_of(w), "omega_0t");
+  w = {};
+  w.ms = std::nan("");
+  EXPECT_EQ(field_of(w), "ms");
+  w = {};
+  w.backoff = 0.5;
+  EXPECT_EQ(field_of(w), "backoff");
+}
+
+}  // namespace hinf_test
+}  // namespace
+}  // namespace servotwin::tuning

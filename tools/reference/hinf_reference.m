@@ -1,0 +1,126 @@
+% Reference values for core/hinf (H-infinity synthesis) and tuning/hinf (the mixed-sensitivity
+% design of catalog C7.14), from GNU Octave's control package: hinfsyn with the SUBOPTIMAL method
+% at a fixed gamma (SLICOT SB10FD, the central controller) for the controller's frequency response,
+% and a bisection on gamma with the same SUBOPTIMAL call as the feasibility test for the optimal
+% gamma. (The OPTIMAL method, SLICOT SB10AD, is only the starting bracket: with a tight TOLGAM it
+% returned gamma = 9.09 for velocity_r4_friction, whose optimum is 1.298.)
+% Run from the repository root:
+%   octave --no-gui --quiet tools/reference/hinf_reference.m
+% Writes tests/data/core/hinf_reference.json.
+pkg load control
+s = tf('s');
+
+cases = {};
+
+% C7.14 velocity mixed sensitivity on a normalized two-mass plant: Pe = Pm/s,
+% z = [W1 y; W2 u], y_meas = -(Pe u + V w); the weights as printed (catalog C7.14), V's
+% denominator = Pe's (the open-loop poles), built here from transfer functions, independently of
+% the C++ realization.
+function P = velocity_plant(r, zz, zp, a, w0S, w0T, xv, Ms, Mt)
+  s = tf('s');
+  N = s^2 + 2*zz*s + 1;
+  D = s^2 + 2*zp*r*s + r^2;
+  den = s*(s + a)*D;
+  Pe = N/den;
+  V = (s + w0S)^2*(s^2 + 2*xv*r*s + r^2)/den;
+  W2 = (1/Mt)*(s + w0T)^2*(s + r)^2/((s + w0S)^2*(s^2 + 2*xv*r*s + r^2)*(w0T*r)^2);
+  G = minreal(ss([V Pe]));              % one shared realization of the open-loop poles
+  assert(rows(G.a) == 4);
+  [ag, bg, cg, dg] = ssdata(G);
+  [aw, bw, cw, dw] = ssdata(ss(W2));
+  nw = rows(aw);
+  % Assembled by blocks: a minreal of the stacked system kept duplicate integrators here.
+  P = ss(blkdiag(ag, aw), [bg; zeros(nw, 1), bw], ...
+         [cg/Ms, zeros(1, nw); zeros(1, 4), cw; -cg, zeros(1, nw)], [dg/Ms; 0, dw; -dg]);
+end
+
+vel = {struct('name', 'velocity_r2', 'r', 2, 'zz', 0.01, 'zp', 0.02, 'a', 0, 'w0S', 0.5, 'w0T', 2, 'xv', 0.8, 'Ms', 1.5, 'Mt', 1.5), ...
+       struct('name', 'velocity_r3_slow', 'r', 3, 'zz', 0.01, 'zp', 0.03, 'a', 0, 'w0S', 0.05, 'w0T', 3, 'xv', 0.8, 'Ms', 1.5, 'Mt', 1.5), ...
+       struct('name', 'velocity_r4_friction', 'r', 4, 'zz', 0.02, 'zp', 0.1, 'a', 0.05, 'w0S', 0.8, 'w0T', 8, 'xv', 0.7071, 'Ms', 1.5, 'Mt', 1.8)};
+for i = 1:numel(vel)
+  v = vel{i};
+  P = velocity_plant(v.r, v.zz, v.zp, v.a, v.w0S, v.w0T, v.xv, v.Ms, v.Mt);
+  cases{end+1} = struct('name', v.name, 'P', P, 'nmeas', 1, 'ncon', 1, 'weights', v);
+end
+
+% A 2x2-exogenous MIMO problem with every block of D11 non-zero, D22 != 0 and an unstable A
+% (fixed numbers): exercises the general formulas (D1111 non-empty), not only mixed sensitivity.
+A = [0.5 1 0 0; -1 -0.2 0.3 0; 0 0 -2 1; 0.2 0 0 -1];
+B1 = [1 0; 0 0.5; 0.3 0; 0 1];
+B2 = [0; 1; 0; 0.5];
+C1 = [1 0 0.5 0; 0 0 0 0.2];
+C2 = [0 1 0 1];
+D11 = [0.1 0.2; 0.05 0.3];
+D12 = [0.3; 1];
+D21 = [0.2 1];
+D22 = 0.4;
+P = ss(A, [B1 B2], [C1; C2], [D11 D12; D21 D22]);
+cases{end+1} = struct('name', 'mimo_general', 'P', P, 'nmeas', 1, 'ncon', 1, 'weights', struct());
+
+% Feasible: SB10FD finds a central controller for gamma and the closed loop is stable below gamma.
+function ok = feasible(P, nmeas, ncon, g)
+  try
+    [~, N] = hinfsyn(P, nmeas, ncon, 'method', 'suboptimal', 'gmax', g);
+    ok = isstable(N) && norm(N, inf, 1e-12) < g;
+  catch
+    ok = false;
+  end
+end
+
+function g = optimal_gamma(P, nmeas, ncon)
+  [~, ~, g0] = hinfsyn(P, nmeas, ncon, 'method', 'optimal', 'tolgam', 1e-2);
+  hi = 1.5 * g0; lo = 0.5 * g0;
+  assert(feasible(P, nmeas, ncon, hi) && ~feasible(P, nmeas, ncon, lo));
+  while hi / lo > 1 + 1e-8
+    mid = sqrt(lo * hi);
+    if feasible(P, nmeas, ncon, mid), hi = mid; else, lo = mid; end
+  end
+  g = hi;
+end
+
+% JSON text with every number at full precision. Octave 7.3's jsonencode wrote
+% -0.99999999999999989 as 0 (found on velocity_r3_slow's C matrix), so numbers are printed here.
+function t = enc(v)
+  if isstruct(v)
+    keys = fieldnames(v);
+    parts = cellfun(@(k) sprintf('"%s": %s', k, enc(v.(k))), keys, 'UniformOutput', false);
+    t = ['{' strjoin(parts', ', ') '}'];
+  elseif iscell(v)
+    t = ['[' strjoin(cellfun(@enc, v, 'UniformOutput', false), ', ') ']'];
+  elseif ischar(v)
+    t = ['"' strrep(v, '"', '\"') '"'];
+  elseif isscalar(v)
+    t = sprintf('%.17g', double(v));
+  elseif rows(v) == 1 || columns(v) == 1
+    t = ['[' strjoin(arrayfun(@(x) sprintf('%.17g', x), v(:)', 'UniformOutput', false), ', ') ']'];
+  else
+    t = ['[' strjoin(arrayfun(@(i) enc(v(i, :)), 1:rows(v), 'UniformOutput', false), ', ') ']'];
+  end
+end
+
+omega = logspace(-2, 2, 17);
+out = {};
+for i = 1:numel(cases)
+  cs = cases{i};
+  [a, b, c, d] = ssdata(cs.P);
+  gopt = optimal_gamma(cs.P, cs.nmeas, cs.ncon);
+  gsub = 1.2 * gopt;
+  [K, N, gk] = hinfsyn(cs.P, cs.nmeas, cs.ncon, 'method', 'suboptimal', 'gmax', gsub);
+  H = freqresp(K, omega);
+  entry = struct('name', cs.name, 'states', rows(a), 'inputs', columns(b), 'outputs', rows(c), ...
+                 'A', a, 'B', b, 'C', c, 'D', d, 'nmeas', cs.nmeas, 'ncon', cs.ncon, ...
+                 'gamma_optimal', gopt, 'gamma_suboptimal', gsub, 'closed_loop_norm', norm(N, inf, 1e-12), ...
+                 'controller_order', rows(K.a), 'omega', omega, 'K_re', real(H(:))', 'K_im', imag(H(:))', ...
+                 'weights', cs.weights);
+  out{end+1} = entry;
+  printf('%s: order %d, gamma_opt %.9g, closed loop %.9g at %.4g\n', cs.name, rows(a), gopt, norm(N, inf, 1e-12), gsub);
+end
+
+doc = struct('generator', 'tools/reference/hinf_reference.m', ...
+             'octave', version(), 'control', pkg('describe', 'control'){1}.version, ...
+             'note', 'K_re/K_im: the SUBOPTIMAL controller at gamma_suboptimal, one SISO value per omega', ...
+             'cases', {out});
+fid = fopen('tests/data/core/hinf_reference.json', 'w');
+fputs(fid, enc(doc));
+fclose(fid);
+printf('wrote tests/data/core/hinf_reference.json\n');
