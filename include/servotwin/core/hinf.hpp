@@ -74,10 +74,13 @@ struct HinfSynthesis {
   int iterations = 0;            ///< central-controller attempts
 };
 
-/// Bisection on gamma (geometric, between a proven infeasible and a feasible value, starting from
-/// the lower bound given by D11) until they are within options.relative_tolerance; then the
-/// central controller at gamma_optimal * backoff and its closed-loop norm, checked to be stable
-/// and below that gamma. Throws std::invalid_argument as hinf_central_controller or for options
+/// Bisection on gamma (geometric, between an infeasible and a feasible value, starting from the
+/// lower bound given by D11) until they are within options.relative_tolerance. While the bracket
+/// is wider than 1 % a gamma counts as feasible when the existence conditions hold; within it,
+/// when the central controller's closed loop is stable and meets gamma (hinf_norm, 1e-6 slack):
+/// in floating point the conditions can pass a little below the optimum. gamma_optimal is the
+/// smallest gamma so verified (raised from the bisection's end if needed); the controller is the
+/// one at gamma_optimal * backoff, verified the same way, balanced (core::balance_states). Throws std::invalid_argument as hinf_central_controller or for options
 /// out of range (tolerance in [1e-10, 0.5], backoff in [1, 10], gamma_max > 0); std::domain_error
 /// when no gamma up to gamma_max is feasible (e.g. an unstabilizable plant).
 [[nodiscard]] HinfSynthesis hinf_synthesis(const StateSpace& plant, Eigen::Index measurements, Eigen::Index controls,
