@@ -31,10 +31,17 @@ void check_weights(const VelocityHinfWeights& w) {
     throw core::InputError(core::at_field("backoff"), "expected a gamma backoff in [1, 10], got " + detail::show(w.backoff));
 }
 
-/// (s + a)^2 (s^2 + 2 xi r s + r^2): the closed-loop poles V and W2 ask for.
-Polynomial target_poles(double omega_0s, double xi_v, double r) {
-  const Polynomial first{1.0, omega_0s};
-  return first * first * Polynomial{1.0, 2.0 * xi_v * r, r * r};
+/// p^k, k >= 0.
+Polynomial power(const Polynomial& p, int k) {
+  Polynomial out{1.0};
+  for (int i = 0; i < k; ++i) out = out * p;
+  return out;
+}
+
+/// (s + w0S)^k (s^2 + 2 xi r s + r^2): the closed-loop poles V and W2 ask for (k = 2 velocity,
+/// 3 position).
+Polynomial target_poles(double omega_0s, double xi_v, double r, int k) {
+  return power(Polynomial{1.0, omega_0s}, k) * Polynomial{1.0, 2.0 * xi_v * r, r * r};
 }
 
 /// Observable canonical form of [n_w / den, n_u / den] + [d_w, 0] over one monic den: both
@@ -63,13 +70,17 @@ core::StateSpace shared_realization(const Polynomial& den, const Polynomial& num
 
 }  // namespace
 
-core::StateSpace velocity_mixed_sensitivity_plant(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {
+namespace {
+
+/// The generalized plant of C7.14 for the velocity (k = 2: Pe = Pm/s) or the position loop (k = 3:
+/// Pe = Pm/s^2), as documented in the header.
+core::StateSpace mixed_sensitivity_plant(const NormalizedPlant& plant, const VelocityHinfWeights& weights, int k) {
   check_weights(weights);
   detail::require_ratio(plant.r, "r");
   const double r = plant.r;
   const double w0s = weights.omega_0s;
   const double w0t = weights.omega_0t.value_or(r);
-  // Pe = Pm/s = N / (s (s + a) D), Im = 1 (normalized_plant.hpp).
+  // Pe = Pm/s^(k-1) = N / (s^(k-1) (s + a) D), Im = 1 (normalized_plant.hpp).
   const Polynomial antiresonance{1.0, 2.0 * plant.zeta_z, 1.0};
   const Polynomial resonance{1.0, 2.0 * plant.zeta_p * r, r * r};
   // Known HF dynamics (torque path, measurement filter, the delay as its first-order Padé
@@ -86,13 +97,13 @@ core::StateSpace velocity_mixed_sensitivity_plant(const NormalizedPlant& plant, 
       extra_den = extra_den * Polynomial{half, 1.0};
     }
   }
-  const Polynomial den = Polynomial{1.0, 0.0} * Polynomial{1.0, plant.a} * resonance * extra_den;
-  const Polynomial target = target_poles(w0s, weights.xi_v, r);
+  const Polynomial den = power(Polynomial{1.0, 0.0}, k - 1) * Polynomial{1.0, plant.a} * resonance * extra_den;
+  const Polynomial target = target_poles(w0s, weights.xi_v, r, k);
   const core::StateSpace g = shared_realization(den, target * extra_den, antiresonance * extra_num);
 
   const Polynomial lead_t{1.0, w0t}, lead_r{1.0, r};
-  const core::TransferFunction w2(
-      (1.0 / (weights.mt * w0t * w0t * r * r)) * (lead_t * lead_t * lead_r * lead_r), target);
+  const core::TransferFunction w2((1.0 / (weights.mt * std::pow(w0t, k) * r * r)) * (power(lead_t, k) * lead_r * lead_r),
+                                  target);
   const core::StateSpace w = core::to_state_space(w2);
 
   const Eigen::Index ng = g.states(), nw = w.states();
@@ -114,19 +125,9 @@ core::StateSpace velocity_mixed_sensitivity_plant(const NormalizedPlant& plant, 
   return p;
 }
 
-HinfDesign velocity_hinf(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {
-  HinfDesign d;
-  d.generalized_plant = velocity_mixed_sensitivity_plant(plant, weights);
-  d.omega_0t = weights.omega_0t.value_or(plant.r);
-  core::HinfOptions options;
-  options.backoff = weights.backoff;
-  const core::HinfSynthesis s = core::hinf_synthesis(d.generalized_plant, 1, 1, options);
-  d.k0 = s.design.controller;
-  d.gamma_optimal = s.gamma_optimal;
-  d.gamma = s.design.gamma;
-  d.closed_loop_norm = s.closed_loop_norm;
-
-  // K = K0/s, then u = K (w* - wm) with inputs [w*, wm].
+/// K = K0/s as a 1-DoF law u = K (reference - measurement) with inputs [reference, measurement],
+/// balanced, with its poles.
+void add_compensator(HinfDesign& d) {
   core::StateSpace integrator;
   integrator.A = MatrixXd::Zero(1, 1);
   integrator.B = MatrixXd::Ones(1, 1);
@@ -141,7 +142,39 @@ HinfDesign velocity_hinf(const NormalizedPlant& plant, const VelocityHinfWeights
   d.compensator.D << k.D, -k.D;
   d.controller_poles = detail::sorted_poles(k.A);
   d.controller_stable = stable_except_integrator(d.controller_poles);
+}
+
+HinfDesign design(const NormalizedPlant& plant, const VelocityHinfWeights& weights, int k) {
+  HinfDesign d;
+  d.generalized_plant = mixed_sensitivity_plant(plant, weights, k);
+  d.omega_0t = weights.omega_0t.value_or(plant.r);
+  core::HinfOptions options;
+  options.backoff = weights.backoff;
+  const core::HinfSynthesis s = core::hinf_synthesis(d.generalized_plant, 1, 1, options);
+  d.k0 = s.design.controller;
+  d.gamma_optimal = s.gamma_optimal;
+  d.gamma = s.design.gamma;
+  d.closed_loop_norm = s.closed_loop_norm;
+  add_compensator(d);
   return d;
+}
+
+}  // namespace
+
+core::StateSpace velocity_mixed_sensitivity_plant(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {
+  return mixed_sensitivity_plant(plant, weights, 2);
+}
+
+core::StateSpace position_mixed_sensitivity_plant(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {
+  return mixed_sensitivity_plant(plant, weights, 3);
+}
+
+HinfDesign velocity_hinf(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {
+  return design(plant, weights, 2);
+}
+
+HinfDesign position_hinf(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {
+  return design(plant, weights, 3);
 }
 
 }  // namespace servotwin::tuning

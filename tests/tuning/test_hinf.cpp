@@ -123,6 +123,58 @@ TEST(VelocityHinf, SensitivityRespectsTheMixedSensitivityBound) {
   }
 }
 
+// The position design (C7.14's position weights, Pe = Pm/s^2): the generalized plant equals
+// Octave's construction, gamma and K0 match hinfsyn, and the loop it closes on the position plant
+// Pm/s respects |S| <= gamma Ms |den(Pe)| / |(s + w0S)^3 (s^2 + 2 xi_v r s + r^2)|.
+TEST(PositionHinf, MatchesOctaveAndRespectsTheMixedSensitivityBound) {
+  const nlohmann::json* found = nullptr;
+  for (const auto& c : reference()["cases"])
+    if (c["name"] == "position_r3") found = &c;
+  ASSERT_NE(found, nullptr);
+  const nlohmann::json& c = *found;
+  const auto& w = c["weights"];
+  const NormalizedPlant plant =
+      normalized_two_mass(w["r"].get<double>(), w["zz"].get<double>(), w["zp"].get<double>(), w["a"].get<double>());
+  VelocityHinfWeights weights;
+  weights.omega_0s = w["w0S"].get<double>();
+  weights.omega_0t = w["w0T"].get<double>();
+  weights.xi_v = w["xv"].get<double>();
+  const auto n = c["states"].get<Eigen::Index>();
+  const core::StateSpace octave = {test_support::octave_matrix(c["A"], n, n), test_support::octave_matrix(c["B"], n, 2),
+                                   test_support::octave_matrix(c["C"], 3, n), test_support::octave_matrix(c["D"], 3, 2)};
+  const core::StateSpace p = position_mixed_sensitivity_plant(plant, weights);
+  ASSERT_EQ(p.states(), 10);
+  for (const double f : {0.01, 0.3, 1.0, 3.0, 30.0}) {
+    const Eigen::MatrixXcd expected = core::frequency_response(octave, f);
+    EXPECT_LT((core::frequency_response(p, f) - expected).norm(), 1e-9 * expected.norm()) << "omega " << f;
+  }
+  const HinfDesign d = position_hinf(plant, weights);
+  const double gamma_octave = c["gamma_optimal"].get<double>();
+  // Ours lies below SLICOT's here (6e-4): SB10FD gives up earlier near the optimum; ours is met by
+  // its controller's closed loop (closed_loop_norm, checked against gamma).
+  EXPECT_LE(d.gamma_optimal, gamma_octave * (1.0 + 2e-4));
+  EXPECT_GE(d.gamma_optimal, gamma_octave * (1.0 - 1e-3));
+  EXPECT_LT(d.closed_loop_norm, d.gamma * (1.0 + 1e-6));
+  const auto k0 = core::hinf_central_controller(p, 1, 1, c["gamma_suboptimal"].get<double>());
+  ASSERT_TRUE(k0.has_value());
+  for (std::size_t i = 0; i < c["omega"].size(); ++i) {
+    const std::complex<double> expected(c["K_re"][i].get<double>(), c["K_im"][i].get<double>());
+    EXPECT_LT(std::abs(core::frequency_response(k0->controller, c["omega"][i].get<double>(), 0, 0) - expected),
+              1e-6 * std::abs(expected));
+  }
+  const double r = plant.r, w0s = weights.omega_0s, xv = weights.xi_v;
+  const core::TransferFunction motor = plant.motor(false);
+  for (const double f : core::log_space(1e-2, 1e2, 61)) {
+    const std::complex<double> s(0.0, f);
+    const std::complex<double> loop = motor(s) / s * core::frequency_response(d.compensator, f, 0, 1) * -1.0;
+    const std::complex<double> sensitivity = 1.0 / (1.0 + loop);
+    const std::complex<double> den = s * s * (s + plant.a) * (s * s + 2.0 * plant.zeta_p * r * s + r * r);
+    const std::complex<double> target = std::pow(s + w0s, 3) * (s * s + 2.0 * xv * r * s + r * r);
+    EXPECT_LE(std::abs(sensitivity), d.gamma * weights.ms * std::abs(den) / std::abs(target) * (1.0 + 1e-6))
+        << "omega " << f;
+  }
+}
+
 TEST(VelocityHinf, RejectsWeightsOutOfRange) {
   const NormalizedPlant plant = normalized_two_mass(3.0, 0.01);
   const auto field_of = [&](VelocityHinfWeights w) {

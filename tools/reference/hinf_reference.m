@@ -34,6 +34,24 @@ function P = velocity_plant(r, zz, zp, a, w0S, w0T, xv, Ms, Mt)
          [cg/Ms, zeros(1, nw); zeros(1, 4), cw; -cg, zeros(1, nw)], [dg/Ms; 0, dw; -dg]);
 end
 
+% C7.14's position weights: Pe = Pm/s^2, cubes of (s + w0S) and (s + w0T) (catalog C7.14).
+function P = position_plant(r, zz, zp, a, w0S, w0T, xv, Ms, Mt)
+  s = tf('s');
+  N = s^2 + 2*zz*s + 1;
+  D = s^2 + 2*zp*r*s + r^2;
+  den = s^2*(s + a)*D;
+  Pe = N/den;
+  V = (s + w0S)^3*(s^2 + 2*xv*r*s + r^2)/den;
+  W2 = (1/Mt)*(s + w0T)^3*(s + r)^2/((s + w0S)^3*(s^2 + 2*xv*r*s + r^2)*(w0T^3*r^2));
+  G = minreal(ss([V Pe]));
+  assert(rows(G.a) == 5);
+  [ag, bg, cg, dg] = ssdata(G);
+  [aw, bw, cw, dw] = ssdata(ss(W2));
+  nw = rows(aw);
+  P = ss(blkdiag(ag, aw), [bg; zeros(nw, 1), bw], ...
+         [cg/Ms, zeros(1, nw); zeros(1, 5), cw; -cg, zeros(1, nw)], [dg/Ms; 0, dw; -dg]);
+end
+
 vel = {struct('name', 'velocity_r2', 'r', 2, 'zz', 0.01, 'zp', 0.02, 'a', 0, 'w0S', 0.5, 'w0T', 2, 'xv', 0.8, 'Ms', 1.5, 'Mt', 1.5), ...
        struct('name', 'velocity_r3_slow', 'r', 3, 'zz', 0.01, 'zp', 0.03, 'a', 0, 'w0S', 0.05, 'w0T', 3, 'xv', 0.8, 'Ms', 1.5, 'Mt', 1.5), ...
        struct('name', 'velocity_r4_friction', 'r', 4, 'zz', 0.02, 'zp', 0.1, 'a', 0.05, 'w0S', 0.8, 'w0T', 8, 'xv', 0.7071, 'Ms', 1.5, 'Mt', 1.8)};
@@ -42,6 +60,10 @@ for i = 1:numel(vel)
   P = velocity_plant(v.r, v.zz, v.zp, v.a, v.w0S, v.w0T, v.xv, v.Ms, v.Mt);
   cases{end+1} = struct('name', v.name, 'P', P, 'nmeas', 1, 'ncon', 1, 'weights', v);
 end
+
+pos = struct('name', 'position_r3', 'r', 3, 'zz', 0.01, 'zp', 0.03, 'a', 0, 'w0S', 0.4, 'w0T', 3, 'xv', 0.8, 'Ms', 1.5, 'Mt', 1.5);
+P = position_plant(pos.r, pos.zz, pos.zp, pos.a, pos.w0S, pos.w0T, pos.xv, pos.Ms, pos.Mt);
+cases{end+1} = struct('name', pos.name, 'P', P, 'nmeas', 1, 'ncon', 1, 'weights', pos);
 
 % A 2x2-exogenous MIMO problem with every block of D11 non-zero, D22 != 0 and an unstable A
 % (fixed numbers): exercises the general formulas (D1111 non-empty), not only mixed sensitivity.

@@ -19,6 +19,12 @@
 /// V and Pe share one realization of den(Pe), so the disturbance model's integrators are the
 /// plant's own (stabilizable) and D21 = 1: the disturbance-feedforward case, Y = 0.
 ///
+/// Position loop (C7.14's position weights): Pe = Pm/s^2 (the position plant Pm/s with integral
+/// action), the measurement the motor position, and the same weights with cubes:
+///   W2 = (1/Mt) (s + w0T)^3 (s + r)^2 / [(s + w0S)^3 (s^2 + 2 xi_v r s + r^2) w0T^3 r^2],
+///   V  = (s + w0S)^3 (s^2 + 2 xi_v r s + r^2) / den(Pe);
+/// K = K0/s maps the position error to the torque.
+///
 /// The design model is the first mode's two-mass plant Pm (normalized_plant.hpp) without higher
 /// modes, times the plant's known HF dynamics (hf: current lag, lag, measurement filter, and the
 /// delay as its first-order Padé approximant (1 - sT/2)/(1 + sT/2)); V's numerator gets the same
@@ -34,7 +40,7 @@
 
 namespace servotwin::tuning {
 
-/// C7.14's velocity weights (normalized frequencies).
+/// C7.14's weights (normalized frequencies), for the velocity and the position designs.
 struct VelocityHinfWeights {
   double omega_0s = 0.5;            ///< w0S: dominant closed-loop pole pair (> 0)
   std::optional<double> omega_0t;   ///< w0T: bandwidth cap (> 0); default r
@@ -48,7 +54,7 @@ struct VelocityHinfWeights {
 struct HinfDesign {
   core::StateSpace generalized_plant;  ///< inputs [w, u0], outputs [z1, z2, e]
   core::StateSpace k0;                 ///< controller of Pe: e -> u0
-  core::StateSpace compensator;        ///< K = K0/s as inputs [w*, wm], output torque (1-DoF: u = K (w* - wm))
+  core::StateSpace compensator;        ///< K = K0/s as inputs [w*, wm] (position: [φ*, φm]), output torque (1-DoF)
   double gamma_optimal = 0.0;          ///< optimal gamma (core::hinf_synthesis, relative tolerance 1e-4)
   double gamma = 0.0;                  ///< gamma of the returned controller (gamma_optimal * backoff)
   double closed_loop_norm = 0.0;       ///< ||F_l(P, K0)||_inf
@@ -68,5 +74,14 @@ struct HinfDesign {
 /// velocity_mixed_sensitivity_plant and for a backoff outside [1, 10]; std::domain_error when the
 /// synthesis finds no controller (not expected for valid weights: the problem is always solvable).
 [[nodiscard]] HinfDesign velocity_hinf(const NormalizedPlant& plant, const VelocityHinfWeights& weights);
+
+/// The position loop's generalized plant (Pe = Pm/s^2, cubic weights; 10 states plus one per HF
+/// factor). Same errors as velocity_mixed_sensitivity_plant.
+[[nodiscard]] core::StateSpace position_mixed_sensitivity_plant(const NormalizedPlant& plant,
+                                                                const VelocityHinfWeights& weights);
+
+/// The C7.14 position design: K = K0/s from the position error [φ*, φm] to the torque. Same errors
+/// as velocity_hinf. The tuner does not offer it yet (its loop analysis is the velocity loop's).
+[[nodiscard]] HinfDesign position_hinf(const NormalizedPlant& plant, const VelocityHinfWeights& weights);
 
 }  // namespace servotwin::tuning
