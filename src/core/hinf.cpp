@@ -46,18 +46,17 @@ void full_column_rank_qr(const MatrixXd& m, MatrixXd& q, MatrixXd& r, const char
   r = qr.matrixQR().topRows(m.cols()).triangularView<Eigen::Upper>();
 }
 
-Normalized normalize(const StateSpace& given, Index ny, Index nu) {
-  require(given.A.rows() == given.A.cols() && given.B.rows() == given.A.rows() && given.C.cols() == given.A.rows() &&
-              given.D.rows() == given.C.rows() && given.D.cols() == given.B.cols(),
+Normalized normalize(const StateSpace& p, Index ny, Index nu) {
+  require(p.A.rows() == p.A.cols() && p.B.rows() == p.A.rows() && p.C.cols() == p.A.rows() &&
+              p.D.rows() == p.C.rows() && p.D.cols() == p.B.cols(),
           "inconsistent state-space shapes");
-  require(given.states() >= 1, "the plant needs at least one state");
-  require(given.A.allFinite() && given.B.allFinite() && given.C.allFinite() && given.D.allFinite(),
+  require(p.states() >= 1, "the plant needs at least one state");
+  require(p.A.allFinite() && p.B.allFinite() && p.C.allFinite() && p.D.allFinite(),
           "matrices must be finite");
-  require(nu >= 1 && ny >= 1 && nu < given.inputs() && ny < given.outputs(),
+  require(nu >= 1 && ny >= 1 && nu < p.inputs() && ny < p.outputs(),
           "need at least one control, one measurement, one exogenous input and one performance output");
-  // Not balanced: a diagonal similarity on A alone (detail::balanced) made the C7.14 problems worse
-  // near their optimum (measured: gamma 13 % too high on velocity_r2).
-  const StateSpace& p = given;
+  // The plant is not balanced here: a diagonal similarity on A alone (detail::balanced) made the
+  // C7.14 problems worse near their optimum (measured: gamma 13 % too high on velocity_r2).
   Normalized s;
   s.n = p.states();
   s.m2 = nu;

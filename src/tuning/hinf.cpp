@@ -9,6 +9,7 @@
 #include "servotwin/core/polynomial.hpp"
 #include "servotwin/core/transfer_function.hpp"
 #include "servotwin/tuning/lqg.hpp"
+#include "servotwin/tuning/velocity_loop.hpp"
 
 namespace servotwin::tuning {
 
@@ -21,8 +22,7 @@ void check_weights(const VelocityHinfWeights& w) {
   detail::require_positive(w.omega_0s, "omega_0s", "a pole-pair frequency w0S");
   if (w.omega_0t) detail::require_positive(*w.omega_0t, "omega_0t", "a bandwidth cap w0T");
   detail::require_finite(w.xi_v, "xi_v");
-  // C7.14's range is [sqrt(2)/2, 1]; 0.7 lets a rounded sqrt(2)/2 through.
-  if (w.xi_v < 0.7 || w.xi_v > 1.0)
+  if (w.xi_v < kXiVMin || w.xi_v > kXiVMax)
     throw core::InputError(core::at_field("xi_v"),
                            "expected a damping in [0.707, 1] (catalog C7.14), got " + detail::show(w.xi_v));
   detail::require_positive(w.ms, "ms", "a sensitivity peak limit");
@@ -68,10 +68,6 @@ core::StateSpace shared_realization(const Polynomial& den, const Polynomial& num
   return g;
 }
 
-}  // namespace
-
-namespace {
-
 /// The generalized plant of C7.14 for the velocity (k = 2: Pe = Pm/s) or the position loop (k = 3:
 /// Pe = Pm/s^2), as documented in the header.
 core::StateSpace mixed_sensitivity_plant(const NormalizedPlant& plant, const VelocityHinfWeights& weights, int k) {
@@ -91,10 +87,10 @@ core::StateSpace mixed_sensitivity_plant(const NormalizedPlant& plant, const Vel
     const core::TransferFunction act = plant.hf.actuator_rational(), fb = plant.hf.feedback_rational();
     extra_num = act.num() * fb.num();
     extra_den = act.den() * fb.den();
-    if (plant.hf.delay_s && *plant.hf.delay_s > 0.0) {
-      const double half = 0.5 * *plant.hf.delay_s;
-      extra_num = extra_num * Polynomial{-half, 1.0};
-      extra_den = extra_den * Polynomial{half, 1.0};
+    if (plant.hf.delay_s) {
+      const core::TransferFunction pade = pade_delay(*plant.hf.delay_s, 1);
+      extra_num = extra_num * pade.num();
+      extra_den = extra_den * pade.den();
     }
   }
   const Polynomial den = power(Polynomial{1.0, 0.0}, k - 1) * Polynomial{1.0, plant.a} * resonance * extra_den;

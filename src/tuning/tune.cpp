@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <stdexcept>
 
@@ -51,7 +52,7 @@ void validate(const TuneOptions& o) {
   if (o.omega_0t)
     require(std::isfinite(*o.omega_0t) && *o.omega_0t > 0.0, "--omega-0t",
             fmt::format("expected w0T/omega_z > 0, got {}", *o.omega_0t));
-  require(std::isfinite(o.xi_v) && o.xi_v >= 0.7 && o.xi_v <= 1.0, "--xi-v",
+  require(std::isfinite(o.xi_v) && o.xi_v >= kXiVMin && o.xi_v <= kXiVMax, "--xi-v",
           fmt::format("expected a damping in [0.707, 1] (catalog C7.14), got {}", o.xi_v));
   if (o.w2) {
     require(o.w2->is_proper(), "--w2", "the uncertainty weight must be proper (numerator degree <= denominator degree)");
@@ -535,11 +536,16 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
   const HinfDesigner h{plant, first, options};
   HinfSummary s;
   s.xi_v = options.xi_v;
+  std::map<double, double> ladder;  // w0S -> the w0T its evaluation chose
   if (options.omega_0s) {
     s.omega_0s = *options.omega_0s;
     s.omega_0s_source = "given";
   } else {
-    const auto evaluate = [&](double w) { return evaluate_hinf(h, check, w).candidate; };
+    const auto evaluate = [&](double w) {
+      const HinfCandidate c = evaluate_hinf(h, check, w);
+      ladder[w] = c.omega_0t;
+      return c.candidate;
+    };
     // C7.14's loop: raise w0S while some w0T meets the spec; stop after two w0S in a row that no
     // w0T of the ladder rescues (a faster pair only raises the peaks further).
     bool met = false;
@@ -564,7 +570,12 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
     s.omega_0s_source = options.w2 ? "largest load bandwidth with ||S|| <= Ms, peak <= Mt and robust performance"
                                    : "largest load bandwidth with ||S|| <= Ms and peak <= Mt";
   }
-  s.omega_0t = options.omega_0t.value_or(evaluate_hinf(h, check, s.omega_0s).omega_0t);
+  if (options.omega_0t) {
+    s.omega_0t = *options.omega_0t;
+  } else {
+    const auto found = ladder.find(s.omega_0s);
+    s.omega_0t = found != ladder.end() ? found->second : evaluate_hinf(h, check, s.omega_0s).omega_0t;
+  }
   HinfDesign d;
   try {
     d = h.design(s.omega_0s, s.omega_0t);

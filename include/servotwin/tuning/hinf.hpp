@@ -40,6 +40,10 @@
 
 namespace servotwin::tuning {
 
+/// The accepted range of xi_v: C7.14's [sqrt(2)/2, 1], the lower end 0.7 so that a rounded
+/// sqrt(2)/2 passes.
+inline constexpr double kXiVMin = 0.7, kXiVMax = 1.0;
+
 /// C7.14's weights (normalized frequencies), for the velocity and the position designs.
 struct VelocityHinfWeights {
   double omega_0s = 0.5;            ///< w0S: dominant closed-loop pole pair (> 0)
