@@ -33,6 +33,8 @@ struct TuneArgs {
   std::string kbw = "auto", kff = "auto";
   std::string omega_0s = "auto", omega_0t = "auto";
   double xi_v = 0.8;
+  std::string modes = "active";
+  std::optional<int> controller_order;
   bool raw_motor_velocity = false;
   std::optional<double> measurement_noise;
   double target_r = 2.0;
@@ -64,6 +66,8 @@ tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
   o.omega_0s = parse_auto(a.omega_0s, "--omega-0s", false, "w0S/omega_z > 0");
   o.omega_0t = parse_auto(a.omega_0t, "--omega-0t", false, "w0T/omega_z > 0");
   o.xi_v = a.xi_v;
+  o.hinf_modes = *tuning::parse_mode_handling(a.modes);
+  o.controller_order = a.controller_order;
   o.lqg.raw_motor_velocity = a.raw_motor_velocity;
   if (a.measurement_noise) {
     o.lqg.measurement_noise = *a.measurement_noise;  // the user's V is kept, not raised
@@ -123,6 +127,18 @@ void print_hinf(const tuning::FullOrderSummary& f, double hz) {
              "({}), w0T = {:.4g} omega_z, xi_v = {}; gamma = {:.4g} (optimum {:.4g})\n",
              f.compensator.states(), h.omega_0s, h.omega_0s * hz, h.omega_0s_source, h.omega_0t, h.xi_v, h.gamma,
              h.gamma_optimal);
+  if (h.modes != tuning::ModeHandling::kFirstMode)
+    fmt::print("higher modes: {} (C7.16)\n", h.modes == tuning::ModeHandling::kActive
+                                                 ? "designed with, damped actively (V extended, eq. 7.164)"
+                                                 : "designed with, cancelled by the controller (passive)");
+  // Below 1e-6 of the largest Hankel value only cancelled states went: the minimal realization.
+  const bool truncated = !h.hankel.empty() && h.reduction_error_bound > 1e-6 * h.hankel.front();
+  fmt::print("controller order: {} of {} ({}); Hankel singular values of its stable part:", f.compensator.states(),
+             h.full_order,
+             truncated ? fmt::format("balanced truncation, ||K_full - K||inf <= {:.3g}", h.reduction_error_bound)
+                       : std::string("minimal realization"));
+  for (double v : h.hankel) fmt::print(" {:.3g}", v);
+  fmt::print("\n");
   fmt::print("controller: {}\n", f.controller_stable ? "stable" : "UNSTABLE (stable only inside the closed loop)");
 }
 
@@ -275,6 +291,15 @@ void register_tune(CLI::App& app, Action& selected) {
       ->capture_default_str();
   cmd->add_option("--xi-v", a->xi_v, "H-infinity: damping of the relocated resonant pair, in [0.707, 1]")
       ->capture_default_str();
+  cmd->add_option("--modes", a->modes,
+                  "H-infinity on a plant with higher modes (C7.16): active (design on the full model, damp every "
+                  "mode), passive (design on it, cancel the higher modes: a notch) or first (design on mode 1, "
+                  "check on the full model)")
+      ->check(CLI::IsMember({"active", "passive", "first"}))
+      ->capture_default_str();
+  cmd->add_option("--controller-order", a->controller_order,
+                  "H-infinity: reduce the controller to this many states by balanced truncation of its stable part "
+                  "(the integrator and unstable poles are kept; default: its minimal realization)");
   cmd->add_option("--target-r", a->target_r, "PID: virtual resonance ratio r-bar the derivative gain creates")
       ->capture_default_str();
   cmd->add_option("--tau", a->tau, "PID: derivative filter time constant [s] (default: 1/max(r, 5 omega*) in omega_z units)");

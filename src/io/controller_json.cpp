@@ -49,6 +49,12 @@ double finite(double v, const std::string& field) {
   return v;
 }
 
+json numbers_json(const std::vector<double>& v, const std::string& field) {
+  json out = json::array();
+  for (std::size_t i = 0; i < v.size(); ++i) out.push_back(finite(v[i], field + "[" + std::to_string(i) + "]"));
+  return out;
+}
+
 json optional_finite(const std::optional<double>& v, const std::string& field) {
   return v ? json(finite(*v, field)) : json(nullptr);
 }
@@ -195,7 +201,11 @@ json hinf_json(const std::optional<tuning::FullOrderSummary>& f) {
               {"omega_0t", finite(h.omega_0t, "hinf.omega_0t")},
               {"xi_v", finite(h.xi_v, "hinf.xi_v")},
               {"gamma_optimal", finite(h.gamma_optimal, "hinf.gamma_optimal")},
-              {"gamma", finite(h.gamma, "hinf.gamma")}};
+              {"gamma", finite(h.gamma, "hinf.gamma")},
+              {"modes", tuning::to_string(h.modes)},
+              {"full_order", h.full_order},
+              {"hankel_singular_values", numbers_json(h.hankel, "hinf.hankel_singular_values")},
+              {"reduction_error_bound", finite(h.reduction_error_bound, "hinf.reduction_error_bound")}};
   add_compensator(out, *f, "hinf");
   return out;
 }
@@ -448,6 +458,20 @@ tuning::DesignParameters read_design(const Section& s, double omega_z, Structure
   return d;
 }
 
+/// An array of finite numbers (possibly empty).
+std::vector<double> read_numbers(const Section& s, std::string_view key) {
+  const json& values = s.raw(key);
+  if (!values.is_array()) s.fail(key, "expected an array of numbers");
+  std::vector<double> out;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const json& e = values[i];
+    if (!e.is_number() || !std::isfinite(e.get<double>()))
+      s.fail(std::string(key) + "[" + std::to_string(i) + "]", "expected a finite number, found " + e.dump());
+    out.push_back(e.get<double>());
+  }
+  return out;
+}
+
 std::vector<std::complex<double>> read_poles(const Section& s, std::string_view key) {
   const json& poles = s.raw(key);
   const std::string name(key);
@@ -639,12 +663,35 @@ void read_compensator(const Section& s, tuning::FullOrderSummary& f) {
                                     (f.controller_stable ? "unstable" : "stable") + ")");
 }
 
+/// The C7.16 members of the hinf section (absent in files of 2026-11-24 and before: a full-order
+/// first-mode design is assumed then).
+void read_reduction(const Section& s, Eigen::Index states, tuning::HinfSummary& h) {
+  h.full_order = static_cast<int>(states);
+  if (!s.value.contains("modes")) return;
+  const std::string modes = s.object.string("modes");
+  const std::optional<tuning::ModeHandling> m = tuning::parse_mode_handling(modes);
+  if (!m) s.fail("modes", "expected \"first\", \"passive\" or \"active\", got \"" + modes + "\"");
+  h.modes = *m;
+  const double full = s.positive("full_order", "a number of states");
+  if (full != std::floor(full) || full < static_cast<double>(states) || full > 1e4)
+    s.fail("full_order", "expected a whole number of states >= the compensator's " + std::to_string(states) + ", got " +
+                             show(full));
+  h.full_order = static_cast<int>(full);
+  h.hankel = read_numbers(s, "hankel_singular_values");
+  for (std::size_t i = 0; i < h.hankel.size(); ++i) {
+    if (!(h.hankel[i] >= 0.0) || (i > 0 && h.hankel[i] > h.hankel[i - 1] * (1.0 + 1e-12)))
+      s.fail("hankel_singular_values[" + std::to_string(i) + "]", "expected non-negative values in descending order");
+  }
+  h.reduction_error_bound = s.non_negative("reduction_error_bound", "an error bound");
+}
+
 /// The "hinf" section: the compensator, its weights and gamma for hinf; null otherwise.
 std::optional<tuning::FullOrderSummary> read_hinf(const Section& root, Structure structure) {
   if (!section_present(root, "hinf", structure == Structure::kHinf, "hinf", structure)) return std::nullopt;
   const Section s = root.section("hinf");
-  s.object.allow_only({"omega_0s", "omega_0s_source", "omega_0t", "xi_v", "gamma_optimal", "gamma",
-                       "controller_stable", "controller_poles", "compensator"});
+  s.object.allow_only({"omega_0s", "omega_0s_source", "omega_0t", "xi_v", "gamma_optimal", "gamma", "modes",
+                       "full_order", "hankel_singular_values", "reduction_error_bound", "controller_stable",
+                       "controller_poles", "compensator"});
   tuning::FullOrderSummary f;
   tuning::HinfSummary h;
   h.omega_0s = s.positive("omega_0s", "a normalized frequency w0S");
@@ -654,8 +701,9 @@ std::optional<tuning::FullOrderSummary> read_hinf(const Section& root, Structure
   h.gamma_optimal = s.positive("gamma_optimal", "an H-infinity norm");
   h.gamma = s.positive("gamma", "an H-infinity norm");
   if (h.gamma < h.gamma_optimal * (1.0 - 1e-9)) s.fail("gamma", "is below gamma_optimal");
-  f.hinf = h;
   read_compensator(s, f);
+  read_reduction(s, f.compensator.states(), h);
+  f.hinf = h;
   return f;
 }
 

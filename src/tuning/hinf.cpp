@@ -1,11 +1,15 @@
 #include "servotwin/tuning/hinf.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "checks.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/hinf.hpp"
+#include "servotwin/core/model_reduction.hpp"
 #include "servotwin/core/polynomial.hpp"
 #include "servotwin/core/transfer_function.hpp"
 #include "servotwin/tuning/lqg.hpp"
@@ -29,6 +33,46 @@ void check_weights(const VelocityHinfWeights& w) {
   detail::require_positive(w.mt, "mt", "a tracking peak limit");
   if (!(w.backoff >= 1.0 && w.backoff <= 10.0))
     throw core::InputError(core::at_field("backoff"), "expected a gamma backoff in [1, 10], got " + detail::show(w.backoff));
+  if (w.controller_order && *w.controller_order < 1)
+    throw core::InputError(core::at_field("controller_order"),
+                           "expected a number of controller states >= 1, got " + std::to_string(*w.controller_order));
+}
+
+/// s^2 + 2 zeta w s + w^2.
+Polynomial quadratic(double omega, double zeta) { return Polynomial{1.0, 2.0 * zeta * omega, omega * omega}; }
+
+/// The rational factors the design model adds to the first mode's Pm: the known HF dynamics
+/// (delay as Padé(1)) and the higher modes, kept apart because V treats them differently.
+struct ExtraDynamics {
+  Polynomial hf_num{1.0}, hf_den{1.0};
+  Polynomial modes_num{1.0}, modes_den{1.0};
+  Polynomial relocated{1.0};  ///< the higher pairs at damping xi_v (V's numerator, kActive)
+};
+
+ExtraDynamics extra_dynamics(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {
+  ExtraDynamics e;
+  // Known HF dynamics (torque path, measurement filter, the delay as its first-order Padé
+  // approximant) enter Pe: C7.14 allows designing with them, and a controller designed without a
+  // delay loses most of its bandwidth to it.
+  if (!plant.hf.empty()) {
+    const core::TransferFunction act = plant.hf.actuator_rational(), fb = plant.hf.feedback_rational();
+    e.hf_num = act.num() * fb.num();
+    e.hf_den = act.den() * fb.den();
+    if (plant.hf.delay_s) {
+      const core::TransferFunction pade = pade_delay(*plant.hf.delay_s, 1);
+      e.hf_num = e.hf_num * pade.num();
+      e.hf_den = e.hf_den * pade.den();
+    }
+  }
+  if (weights.modes == ModeHandling::kFirstMode) return e;
+  // Each higher mode with unit DC gain, as NormalizedPlant::motor() has it.
+  for (const fit::Mode& m : plant.higher_modes) {
+    const double wz = m.antiresonance.omega_rad_s, wp = m.resonance.omega_rad_s;
+    e.modes_num = ((wp * wp) / (wz * wz)) * (e.modes_num * quadratic(wz, m.antiresonance.zeta));
+    e.modes_den = e.modes_den * quadratic(wp, m.resonance.zeta);
+    e.relocated = e.relocated * quadratic(wp, weights.xi_v);
+  }
+  return e;
 }
 
 /// p^k, k >= 0.
@@ -79,23 +123,15 @@ core::StateSpace mixed_sensitivity_plant(const NormalizedPlant& plant, const Vel
   // Pe = Pm/s^(k-1) = N / (s^(k-1) (s + a) D), Im = 1 (normalized_plant.hpp).
   const Polynomial antiresonance{1.0, 2.0 * plant.zeta_z, 1.0};
   const Polynomial resonance{1.0, 2.0 * plant.zeta_p * r, r * r};
-  // Known HF dynamics (torque path, measurement filter, the delay as its first-order Padé
-  // approximant) enter Pe: C7.14 allows designing with them, and a controller designed without a
-  // delay loses most of its bandwidth to it. V keeps its shape: its numerator gets the same poles.
-  Polynomial extra_num{1.0}, extra_den{1.0};
-  if (!plant.hf.empty()) {
-    const core::TransferFunction act = plant.hf.actuator_rational(), fb = plant.hf.feedback_rational();
-    extra_num = act.num() * fb.num();
-    extra_den = act.den() * fb.den();
-    if (plant.hf.delay_s) {
-      const core::TransferFunction pade = pade_delay(*plant.hf.delay_s, 1);
-      extra_num = extra_num * pade.num();
-      extra_den = extra_den * pade.den();
-    }
-  }
-  const Polynomial den = power(Polynomial{1.0, 0.0}, k - 1) * Polynomial{1.0, plant.a} * resonance * extra_den;
+  const ExtraDynamics extra = extra_dynamics(plant, weights);
+  const Polynomial den = power(Polynomial{1.0, 0.0}, k - 1) * Polynomial{1.0, plant.a} * resonance * extra.hf_den *
+                         extra.modes_den;
   const Polynomial target = target_poles(w0s, weights.xi_v, r, k);
-  const core::StateSpace g = shared_realization(den, target * extra_den, antiresonance * extra_num);
+  // V keeps its shape over the HF factors; over the higher modes it either keeps them (passive:
+  // the controller may cancel them) or relocates them (active, eq. 7.164).
+  const Polynomial v_modes = weights.modes == ModeHandling::kActive ? extra.relocated : extra.modes_den;
+  const core::StateSpace g =
+      shared_realization(den, target * extra.hf_den * v_modes, antiresonance * extra.hf_num * extra.modes_num);
 
   const Polynomial lead_t{1.0, w0t}, lead_r{1.0, r};
   const core::TransferFunction w2((1.0 / (weights.mt * std::pow(w0t, k) * r * r)) * (power(lead_t, k) * lead_r * lead_r),
@@ -121,15 +157,55 @@ core::StateSpace mixed_sensitivity_plant(const NormalizedPlant& plant, const Vel
   return p;
 }
 
-/// K = K0/s as a 1-DoF law u = K (reference - measurement) with inputs [reference, measurement],
-/// balanced, with its poles.
-void add_compensator(HinfDesign& d) {
+/// Hankel singular values at or below this fraction of the largest are pole-zero cancellations
+/// (exact ones show at 1e-30, ill-conditioned ones near 1e-7): the default controller drops them,
+/// changing K by at most 2e-6 n of its Hankel scale.
+constexpr double kCancellationLevel = 1e-6;
+
+std::vector<double> as_vector(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
+
+/// K = K0/s, reduced to `order` states when asked: the Hankel singular values of its stable part
+/// are recorded either way.
+core::StateSpace compensator_transfer(HinfDesign& d, std::optional<int> order, bool minimal) {
   core::StateSpace integrator;
   integrator.A = MatrixXd::Zero(1, 1);
   integrator.B = MatrixXd::Ones(1, 1);
   integrator.C = MatrixXd::Ones(1, 1);
   integrator.D = MatrixXd::Zero(1, 1);
-  const core::StateSpace k = core::balance_states(core::series(d.k0, integrator));
+  const core::StateSpace k = core::series(d.k0, integrator);
+  d.full_order = static_cast<int>(k.states());
+  if (!order && !minimal) return k;
+  std::optional<int> target = order;
+  if (!target) {
+    // The minimal realization: W2's poles (the target pair and (s + w0S)^k) cancel in K, which
+    // shows as Hankel singular values near rounding level; those states go, nothing else.
+    try {
+      d.hankel = as_vector(core::hankel_singular_values(core::stable_split(k, core::kStableBoundary).stable));
+    } catch (const std::domain_error&) {
+      d.hankel.clear();  // poles too close to the boundary to split: keep K as it is
+      return k;
+    }
+    const double floor = kCancellationLevel * (d.hankel.empty() ? 0.0 : d.hankel.front());
+    const auto cancelled = std::count_if(d.hankel.begin(), d.hankel.end(), [&](double h) { return h <= floor; });
+    if (cancelled == 0) return k;
+    target = d.full_order - static_cast<int>(cancelled);
+  }
+  const core::StableSplit split = core::stable_split(k, core::kStableBoundary);
+  const int kept = static_cast<int>(split.unstable.states());
+  if (*target < kept || *target > d.full_order)
+    throw core::InputError(core::at_field("controller_order"),
+                           "expected between " + std::to_string(kept) + " (the controller's integrator and unstable poles) and " +
+                               std::to_string(d.full_order) + " (its full order) states, got " + std::to_string(*target));
+  const core::BalancedTruncation bt = core::balanced_truncation_stable_part(k, *target, core::kStableBoundary);
+  d.hankel = as_vector(bt.hankel);
+  d.reduction_error_bound = bt.error_bound;
+  return bt.reduced;
+}
+
+/// K = K0/s as a 1-DoF law u = K (reference - measurement) with inputs [reference, measurement],
+/// balanced, with its poles.
+void add_compensator(HinfDesign& d, std::optional<int> order, bool minimal) {
+  const core::StateSpace k = core::balance_states(compensator_transfer(d, order, minimal));
   d.compensator.A = k.A;
   d.compensator.B.resize(k.states(), 2);
   d.compensator.B << k.B, -k.B;
@@ -151,11 +227,26 @@ HinfDesign design(const NormalizedPlant& plant, const VelocityHinfWeights& weigh
   d.gamma_optimal = s.gamma_optimal;
   d.gamma = s.design.gamma;
   d.closed_loop_norm = s.closed_loop_norm;
-  add_compensator(d);
+  add_compensator(d, weights.controller_order, weights.minimal_realization);
   return d;
 }
 
 }  // namespace
+
+const char* to_string(ModeHandling m) noexcept {
+  switch (m) {
+    case ModeHandling::kPassive: return "passive";
+    case ModeHandling::kActive: return "active";
+    case ModeHandling::kFirstMode: break;
+  }
+  return "first";
+}
+
+std::optional<ModeHandling> parse_mode_handling(const std::string& text) noexcept {
+  for (ModeHandling m : {ModeHandling::kFirstMode, ModeHandling::kPassive, ModeHandling::kActive})
+    if (text == to_string(m)) return m;
+  return std::nullopt;
+}
 
 core::StateSpace velocity_mixed_sensitivity_plant(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {
   return mixed_sensitivity_plant(plant, weights, 2);

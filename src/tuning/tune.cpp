@@ -54,10 +54,20 @@ void validate(const TuneOptions& o) {
             fmt::format("expected w0T/omega_z > 0, got {}", *o.omega_0t));
   require(std::isfinite(o.xi_v) && o.xi_v >= kXiVMin && o.xi_v <= kXiVMax, "--xi-v",
           fmt::format("expected a damping in [0.707, 1] (catalog C7.14), got {}", o.xi_v));
+  if (o.controller_order)
+    require(*o.controller_order >= 1, "--controller-order",
+            fmt::format("expected a number of controller states >= 1, got {}", *o.controller_order));
   if (o.w2) {
     require(o.w2->is_proper(), "--w2", "the uncertainty weight must be proper (numerator degree <= denominator degree)");
     require(core::is_hurwitz(o.w2->den()), "--w2", "the uncertainty weight must be stable (poles in the left half-plane)");
   }
+}
+
+/// What the automatic searches maximize: the load tracking bandwidth where the plant has a load
+/// side (a two-mass realization, as VelocityLoop::has_load()), else the motor's.
+std::string largest_bandwidth(const NormalizedPlant& plant) {
+  const bool load = plant.higher_modes.empty() && physical_parameters_with_friction(plant).has_value();
+  return load ? "largest load bandwidth" : "largest motor bandwidth (no load side)";
 }
 
 /// The frequency grid of the scan: wide enough for every loop function of a normalized plant.
@@ -66,6 +76,10 @@ std::vector<double> scan_grid(const NormalizedPlant& plant) {
   // The lightly damped mode: put its exact frequencies on the grid so its peak is not stepped over.
   g.push_back(1.0);
   g.push_back(plant.r);
+  for (const fit::Mode& m : plant.higher_modes) {
+    g.push_back(m.antiresonance.omega_rad_s);
+    g.push_back(m.resonance.omega_rad_s);
+  }
   std::sort(g.begin(), g.end());
   g.erase(std::unique(g.begin(), g.end()), g.end());
   return g;
@@ -408,8 +422,8 @@ void choose_kbw(const NormalizedPlant& plant, const FrictionTwoMass& model, cons
     if (!options.raise_measurement_noise || decade == kMaxNoiseDecades) no_feasible_omega(result.scan, options);
     f.weights.measurement_noise *= 10.0;
   }
-  f.kbw_source = options.w2 ? "largest load bandwidth with ||S|| <= Ms, tracking peak <= Mt and robust tracking"
-                            : "largest load bandwidth with ||S|| <= Ms and tracking peak <= Mt";
+  f.kbw_source = largest_bandwidth(plant) + (options.w2 ? " with ||S|| <= Ms, tracking peak <= Mt and robust tracking"
+                                                         : " with ||S|| <= Ms and tracking peak <= Mt");
   if (f.weights.measurement_noise != printed) {
     result.controller.notes.push_back(fmt::format(
         "no kbw met the spec with the Kalman filter's measurement noise V = {:g}: V raised to {:g} (a slower "
@@ -490,17 +504,21 @@ constexpr int kOmega0tSteps = 4;  // r, 2r, 4r, 8r
 /// The C7.14 design at (w0S, w0T) on the first mode, and its loop with the HF dynamics.
 struct HinfDesigner {
   const NormalizedPlant& plant;
-  NormalizedPlant first_mode;
+  NormalizedPlant design_plant;  // the plant, or its first mode for ModeHandling::kFirstMode
   const TuneOptions& options;
 
-  [[nodiscard]] HinfDesign design(double omega_0s, double omega_0t) const {
+  /// `final`: the design returned (its minimal realization); the search's candidates skip it.
+  [[nodiscard]] HinfDesign design(double omega_0s, double omega_0t, bool final = false) const {
     VelocityHinfWeights w;
+    w.minimal_realization = final;
     w.omega_0s = omega_0s;
     w.omega_0t = omega_0t;
     w.xi_v = options.xi_v;
     w.ms = options.ms;
     w.mt = options.mt;
-    return velocity_hinf(first_mode, w);
+    w.modes = options.hinf_modes;
+    w.controller_order = options.controller_order;
+    return velocity_hinf(design_plant, w);
   }
   [[nodiscard]] VelocityLoop loop(const HinfDesign& d) const { return VelocityLoop(plant, two_dof_form(d.compensator)); }
 };
@@ -513,7 +531,7 @@ struct HinfCandidate {
 };
 
 HinfCandidate evaluate_hinf(const HinfDesigner& h, const SpecCheck& check, double omega_0s) {
-  const double r = h.first_mode.r;
+  const double r = h.design_plant.r;
   HinfCandidate out;
   for (int step = 0; step < (h.options.omega_0t ? 1 : kOmega0tSteps); ++step) {
     out.omega_0t = h.options.omega_0t.value_or(r * std::ldexp(1.0, step));
@@ -522,20 +540,38 @@ HinfCandidate evaluate_hinf(const HinfDesigner& h, const SpecCheck& check, doubl
     } catch (const std::domain_error&) {
       out.candidate = {};  // no controller for these weights: an unstable candidate
       out.candidate.omega_star = omega_0s;
+    } catch (const InputError& e) {
+      if (e.where().field != "controller_order") throw;
+      out.candidate = {};  // more unstable controller poles than the order asked for
+      out.candidate.omega_star = omega_0s;
     }
     if (out.candidate.feasible) break;
   }
   return out;
 }
 
+/// What the design did with the higher modes (C7.16).
+std::string higher_modes_note(const TuneOptions& o, std::size_t count) {
+  if (o.structure == Structure::kHinf && o.hinf_modes == ModeHandling::kActive)
+    return fmt::format("designed on the full model: the {} higher mode(s) are damped actively (C7.16, V extended "
+                       "as eq. 7.164), at a larger controller gain at their frequencies",
+                       count);
+  if (o.structure == Structure::kHinf && o.hinf_modes == ModeHandling::kPassive)
+    return fmt::format("designed on the full model: the controller cancels the {} higher mode(s) (a notch; "
+                       "C7.16 passive): disturbances at the motor still excite them",
+                       count);
+  return fmt::format("designed on the first mode; {} higher mode(s) are included in every index", count);
+}
+
 /// The hinf path of tune(): w0S and w0T, the compensator, its analysis and robustness.
 void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
   const NormalizedPlant& plant = result.plant;
-  NormalizedPlant first = plant;  // the design plant: the first mode with the known HF dynamics
-  first.higher_modes.clear();
-  const HinfDesigner h{plant, first, options};
+  NormalizedPlant design_plant = plant;  // with the known HF dynamics; C7.16 decides on the modes
+  if (options.hinf_modes == ModeHandling::kFirstMode) design_plant.higher_modes.clear();
+  const HinfDesigner h{plant, design_plant, options};
   HinfSummary s;
   s.xi_v = options.xi_v;
+  s.modes = plant.higher_modes.empty() ? ModeHandling::kFirstMode : options.hinf_modes;
   std::map<double, double> ladder;  // w0S -> the w0T its evaluation chose
   if (options.omega_0s) {
     s.omega_0s = *options.omega_0s;
@@ -567,8 +603,8 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
     if (last + 1 < result.scan.size())
       refine_boundary(result.scan[last].omega_star, result.scan[last + 1].omega_star, evaluate, chosen, kBoundarySteps);
     s.omega_0s = chosen.omega_star;
-    s.omega_0s_source = options.w2 ? "largest load bandwidth with ||S|| <= Ms, peak <= Mt and robust performance"
-                                   : "largest load bandwidth with ||S|| <= Ms and peak <= Mt";
+    s.omega_0s_source = largest_bandwidth(plant) + (options.w2 ? " with ||S|| <= Ms, peak <= Mt and robust performance"
+                                                               : " with ||S|| <= Ms and peak <= Mt");
   }
   if (options.omega_0t) {
     s.omega_0t = *options.omega_0t;
@@ -578,15 +614,21 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
   }
   HinfDesign d;
   try {
-    d = h.design(s.omega_0s, s.omega_0t);
+    d = h.design(s.omega_0s, s.omega_0t, true);
   } catch (const std::domain_error& e) {
     throw InputError(at_field(options.omega_0s ? "--omega-0s" : "--structure"),
                      fmt::format("no H-infinity controller for w0S = {:.4g}, w0T = {:.4g} ({}); try other weights or "
                                  "--omega-0s auto",
                                  s.omega_0s, s.omega_0t, e.what()));
+  } catch (const InputError& e) {
+    if (e.where().field != "controller_order") throw;
+    throw InputError(at_field("--controller-order"), e.reason());
   }
   s.gamma_optimal = d.gamma_optimal;
   s.gamma = d.gamma;
+  s.full_order = d.full_order;
+  s.hankel = d.hankel;
+  s.reduction_error_bound = d.reduction_error_bound;
   FullOrderSummary f;
   f.hinf = s;
   f.compensator = d.compensator;
@@ -627,8 +669,9 @@ void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecChec
     const TuneResult::Candidate chosen = choose(result.scan, [&](double w) { return check(w, design(w)); });
     if (!chosen.feasible) no_feasible_omega(result.scan, options);
     c.design.omega_star = chosen.omega_star;
-    c.design.omega_star_source = options.w2 ? "largest load bandwidth with ||S|| <= Ms, peak <= Mt and robust performance"
-                                            : "largest load bandwidth with ||S|| <= Ms and peak <= Mt";
+    c.design.omega_star_source =
+        largest_bandwidth(plant) + (options.w2 ? " with ||S|| <= Ms, peak <= Mt and robust performance"
+                                               : " with ||S|| <= Ms and peak <= Mt");
   }
   c.normalized = design(c.design.omega_star, &c.notes);
   c.physical = to_physical(c.normalized, plant);
@@ -675,10 +718,7 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   } else {
     tune_cascade(result, options, check);
   }
-  if (!plant.higher_modes.empty()) {
-    c.notes.push_back(fmt::format("designed on the first mode; {} higher mode(s) are included in every index",
-                                  plant.higher_modes.size()));
-  }
+  if (!plant.higher_modes.empty()) c.notes.push_back(higher_modes_note(options, plant.higher_modes.size()));
   if (options.ts) add_discrete(c, *options.ts);
   return result;
 }

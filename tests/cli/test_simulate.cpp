@@ -63,13 +63,15 @@ TEST_F(Cli, TuneLqgAndSimulateIt) {
 }
 
 TEST_F(Cli, TuneHinfAndSimulateIt) {
-  // `tune --structure hinf` (C7.14) writes the controller: 8 states of the weighted plant, one of
-  // the preset's lag designed with, one integrator (K = K0/s); `simulate` runs it on the preset
+  // `tune --structure hinf` (C7.14) writes the controller: 10 states (8 of the weighted plant, one
+  // of the preset's lag designed with, one integrator K = K0/s), 6 in its minimal realization (W2's
+  // 4 poles cancel: C7.14's 5th order plus the lag); `simulate` runs it on the preset
   // with its friction: the integral action balances the same 0.5 + 3.6 = 4.1 N m.
   const Result t = run("tune table-5.1 --structure hinf -o hinf.json --report hinf.html");
   ASSERT_EQ(t.status, 0) << t.err;
-  EXPECT_NE(t.out.find("structure hinf: mixed-sensitivity velocity loop (C7.14, 10 states): w0S = "), std::string::npos)
+  EXPECT_NE(t.out.find("structure hinf: mixed-sensitivity velocity loop (C7.14, 6 states): w0S = "), std::string::npos)
       << t.out;
+  EXPECT_NE(t.out.find("controller order: 6 of 10 (minimal realization)"), std::string::npos) << t.out;
   EXPECT_NE(t.out.find("gamma = "), std::string::npos) << t.out;
   EXPECT_NE(t.out.find("verified by simulation"), std::string::npos) << t.out;
   EXPECT_NE(slurp(path("hinf.html")).find("H∞ mixed-sensitivity design (C7.14"), std::string::npos);

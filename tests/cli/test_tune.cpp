@@ -94,6 +94,44 @@ TEST_F(Cli, TuneExplainsWhatItCannotDo) {
   EXPECT_NE(r.err.find("--kff"), std::string::npos) << r.err;
 }
 
+TEST_F(Cli, TuneHinfOnATwoModePlant) {
+  // C7.16's demo plant (eq. 7.165) as a transfer function: K (s^2 + 0.02 s + 1) * 4 (s^2 + 0.12 s + 36)
+  // / (s (s^2 + 0.32 s + 16)(s^2 + 0.48 s + 144)); the default designs on the full model (active),
+  // --modes passive cancels mode 2, --controller-order truncates the controller.
+  write("two_modes.json",
+        R"({"format": "servotwin.plant/1", "type": "transfer-function", "num": [4, 0.56, 148.0096, 3.36, 144],
+            "den": [1, 0.8, 160.1536, 53.76, 2304, 0], "noise_std": 0, "ts": 0.001})");
+  Result r = run("tune two_modes.json --structure hinf -o active.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("1 higher mode(s)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("higher modes: designed with, damped actively"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("controller order: 7 of 12 (minimal realization)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("largest motor bandwidth (no load side)"), std::string::npos) << r.out;
+  const auto active = nlohmann::json::parse(slurp(path("active.json")));
+  EXPECT_EQ(active["hinf"]["modes"], "active");
+  EXPECT_EQ(active["hinf"]["compensator"]["A"].size(), 7U);
+
+  r = run("tune two_modes.json --structure hinf --modes passive --controller-order 6 -o passive.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("cancelled by the controller (passive)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("controller order: 6 of 12 (balanced truncation, ||K_full - K||inf <= "), std::string::npos)
+      << r.out;
+  const auto passive = nlohmann::json::parse(slurp(path("passive.json")));
+  EXPECT_EQ(passive["hinf"]["modes"], "passive");
+  EXPECT_EQ(passive["hinf"]["full_order"], 12);
+  EXPECT_GT(passive["hinf"]["reduction_error_bound"].get<double>(), 0.0);
+  r = run("simulate --plant two_modes.json --controller passive.json --test step -o step.csv");
+  EXPECT_EQ(r.status, 0) << r.err;
+
+  r = run("tune two_modes.json --structure hinf --modes both");
+  EXPECT_EQ(r.status, 2);  // a usage error listing the choices
+  EXPECT_NE(r.err.find("--modes"), std::string::npos) << r.err;
+  r = run("tune two_modes.json --structure hinf --modes passive --omega-0s 0.6 --controller-order 2");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("--controller-order"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("unstable poles"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, TuneCompareTunesEveryStructureToOneSpec) {
   // C7.15 on table-5.1 (r = 3): a table with PI as the reference (x1.00) and PID and LQG faster.
   const Result r = run("tune compare table-5.1 --report compare.html");

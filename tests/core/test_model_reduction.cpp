@@ -29,7 +29,7 @@ Eigen::MatrixXd matrix(const nlohmann::json& v, Eigen::Index rows, Eigen::Index 
 }
 
 StateSpace system_of(const nlohmann::json& c) {
-  const auto n = static_cast<Eigen::Index>(c["hsv"].size());
+  const auto n = c["states"].get<Eigen::Index>();
   const auto p = c["reduced"][0]["outputs"].get<Eigen::Index>();
   const auto m = c["reduced"][0]["inputs"].get<Eigen::Index>();
   return {matrix(c["A"], n, n), matrix(c["B"], n, m), matrix(c["C"], p, n), matrix(c["D"], p, m)};
@@ -50,8 +50,31 @@ StateSpace difference(const StateSpace& g1, const StateSpace& g2) {
   return d;
 }
 
+bool has_unstable_part(const nlohmann::json& c) { return c["unstable"].get<int>() > 0; }
+
+/// Compares the reduced model's frequency response with Octave's (column-major over output,
+/// input, frequency) to 1e-6 of the response's scale.
+void expect_octave_response(const StateSpace& reduced, const nlohmann::json& c, const nlohmann::json& r) {
+  const std::string name = c["name"];
+  const auto order = r["order"].get<Eigen::Index>();
+  std::size_t k = 0;
+  for (const auto& w : c["omega"]) {
+    const Eigen::MatrixXcd h = frequency_response(reduced, w.get<double>());
+    for (Eigen::Index j = 0; j < reduced.inputs(); ++j) {
+      for (Eigen::Index i = 0; i < reduced.outputs(); ++i, ++k) {
+        const std::complex<double> expected(r["re"][k].get<double>(), r["im"][k].get<double>());
+        // Near-equal discarded/kept values (two_mass at order 1: 6.5040 / 6.5033) make the
+        // truncation itself sensitive: compared to 1e-6 of the response's scale.
+        EXPECT_NEAR(std::abs(h(i, j) - expected), 0.0, 1e-6 * std::max(1.0, std::abs(expected)))
+            << name << " order " << order << " w " << w << " (" << i << "," << j << ")";
+      }
+    }
+  }
+}
+
 TEST(BalancedTruncation, MatchesOctaveHankelValuesAndReducedResponses) {
   for (const auto& c : fixture()["cases"]) {
+    if (has_unstable_part(c)) continue;
     const std::string name = c["name"];
     const StateSpace g = system_of(c);
     const Eigen::VectorXd hsv = hankel_singular_values(g);
@@ -62,20 +85,7 @@ TEST(BalancedTruncation, MatchesOctaveHankelValuesAndReducedResponses) {
       const auto order = r["order"].get<Eigen::Index>();
       const BalancedTruncation bt = balanced_truncation(g, order);
       ASSERT_EQ(bt.reduced.states(), order) << name;
-      const auto p = g.outputs(), m = g.inputs();
-      std::size_t k = 0;  // column-major over (output, input, frequency)
-      for (const auto& w : c["omega"]) {
-        const Eigen::MatrixXcd h = frequency_response(bt.reduced, w.get<double>());
-        for (Eigen::Index j = 0; j < m; ++j) {
-          for (Eigen::Index i = 0; i < p; ++i, ++k) {
-            const std::complex<double> expected(r["re"][k].get<double>(), r["im"][k].get<double>());
-            // Near-equal discarded/kept values (two_mass at order 1: 6.5040 / 6.5033) make the
-            // truncation itself sensitive: compared to 1e-6 of the response's scale.
-            EXPECT_NEAR(std::abs(h(i, j) - expected), 0.0, 1e-6 * std::max(1.0, std::abs(expected)))
-                << name << " order " << order << " w " << w << " (" << i << "," << j << ")";
-          }
-        }
-      }
+      expect_octave_response(bt.reduced, c, r);
     }
   }
 }
@@ -84,6 +94,7 @@ TEST(BalancedTruncation, ErrorLiesBetweenGloversBounds) {
   // sigma_{r+1} <= ||G - G_r||_inf <= 2 sum_{i>r} sigma_i (distinct values), and the reduced model
   // is balanced: its Hankel singular values are the retained ones.
   for (const auto& c : fixture()["cases"]) {
+    if (has_unstable_part(c)) continue;
     const StateSpace g = system_of(c);
     for (Eigen::Index order = 1; order < g.states(); ++order) {
       const BalancedTruncation bt = balanced_truncation(g, order);
@@ -130,6 +141,65 @@ TEST(BalancedTruncation, RefusesUnstableSystemsAndBadOrders) {
   StateSpace bad = g;
   bad.B.resize(2, 1);
   EXPECT_THROW((void)hankel_singular_values(bad), std::invalid_argument);
+}
+
+/// The eigenvalues of A (none for a zero-state system, where Eigen's solver must not be called).
+Eigen::VectorXcd poles(const StateSpace& g) {
+  return g.states() == 0 ? Eigen::VectorXcd() : Eigen::VectorXcd(g.A.eigenvalues());
+}
+
+TEST(StableSplit, SumsToTheSystemWithThePolesSeparated) {
+  // Gs + Gu = G at every frequency; Gs has the poles left of the boundary, Gu the others (the
+  // C7.19 controller: its integrator and unstable pair 0.48 +- 1.63j, stable pair of 22.35 s + 274.2).
+  for (const auto& c : fixture()["cases"]) {
+    const StateSpace g = system_of(c);
+    const StableSplit split = stable_split(g, kStableBoundary);
+    EXPECT_EQ(split.unstable.states(), c["unstable"].get<Eigen::Index>()) << c["name"];
+    EXPECT_EQ(split.stable.states() + split.unstable.states(), g.states());
+    for (const std::complex<double>& p : poles(split.stable)) EXPECT_LT(p.real(), kStableBoundary);
+    for (const std::complex<double>& p : poles(split.unstable)) EXPECT_GE(p.real(), kStableBoundary);
+    for (const double w : {0.05, 0.7, 1.63, 9.0, 120.0}) {
+      const Eigen::MatrixXcd sum = frequency_response(split.stable, w) + frequency_response(split.unstable, w);
+      const Eigen::MatrixXcd h = frequency_response(g, w);
+      EXPECT_LT((sum - h).norm(), 1e-9 * std::max(1.0, h.norm())) << c["name"] << " w " << w;
+    }
+  }
+}
+
+TEST(BalancedTruncation, StablePartMatchesOctavesBtamodredOnUnstableControllers) {
+  // btamodred (SLICOT AB09MD) keeps the poles right of -sqrt(eps) and reduces the rest; hsvd's
+  // finite values are those of the stable part.
+  int checked = 0;
+  for (const auto& c : fixture()["cases"]) {
+    if (!has_unstable_part(c)) continue;
+    const StateSpace g = system_of(c);
+    for (const auto& r : c["reduced"]) {
+      const auto order = r["order"].get<Eigen::Index>();
+      const BalancedTruncation bt = balanced_truncation_stable_part(g, order);
+      ASSERT_EQ(bt.reduced.states(), order) << c["name"];
+      EXPECT_EQ(bt.unstable_states, c["unstable"].get<Eigen::Index>());
+      ASSERT_EQ(bt.hankel.size(), static_cast<Eigen::Index>(c["hsv"].size()));
+      for (Eigen::Index i = 0; i < bt.hankel.size(); ++i)
+        EXPECT_NEAR(bt.hankel[i], c["hsv"][static_cast<std::size_t>(i)].get<double>(), 1e-9 * bt.hankel[0]) << c["name"];
+      expect_octave_response(bt.reduced, c, r);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 5);
+}
+
+TEST(BalancedTruncation, StablePartRefusesOrdersBelowTheKeptStates) {
+  const auto& c = fixture()["cases"][3];
+  ASSERT_EQ(c["name"], "c7_19_controller");
+  const StateSpace g = system_of(c);
+  EXPECT_THROW((void)balanced_truncation_stable_part(g, 2), std::invalid_argument);
+  EXPECT_THROW((void)balanced_truncation_stable_part(g, 6), std::invalid_argument);
+  // A stable system goes through unchanged: the same result as balanced_truncation.
+  const StateSpace stable = system_of(fixture()["cases"][0]);
+  const BalancedTruncation a = balanced_truncation_stable_part(stable, 3), b = balanced_truncation(stable, 3);
+  EXPECT_EQ(a.unstable_states, 0);
+  for (const double w : {0.3, 3.0})
+    EXPECT_LT((frequency_response(a.reduced, w) - frequency_response(b.reduced, w)).norm(), 1e-10);
 }
 
 }  // namespace model_reduction_test

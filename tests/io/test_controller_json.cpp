@@ -223,6 +223,10 @@ void expect_round_trip(const Controller& c, const Controller& b) {
       EXPECT_EQ(f.hinf->gamma_optimal, g.hinf->gamma_optimal);
       EXPECT_EQ(f.hinf->gamma, g.hinf->gamma);
       EXPECT_EQ(f.hinf->omega_0s_source, g.hinf->omega_0s_source);
+      EXPECT_EQ(f.hinf->modes, g.hinf->modes);
+      EXPECT_EQ(f.hinf->full_order, g.hinf->full_order);
+      EXPECT_EQ(f.hinf->hankel, g.hinf->hankel);
+      EXPECT_EQ(f.hinf->reduction_error_bound, g.hinf->reduction_error_bound);
     }
   }
   ASSERT_EQ(b.discrete.has_value(), c.discrete.has_value());
@@ -667,7 +671,14 @@ TEST(ControllerJsonRoundTrip, HinfFromTheTuner) {
   const nlohmann::json j = controller_to_json(c, "two_mass.json");
   EXPECT_TRUE(j["lqg"].is_null());
   EXPECT_TRUE(j["gains"].is_null());
-  EXPECT_EQ(j["hinf"]["compensator"]["A"].size(), 9U);
+  EXPECT_EQ(j["hinf"]["compensator"]["A"].size(), 5U);  // the minimal realization (C7.14: 5th order)
+  EXPECT_EQ(j["hinf"]["full_order"], 9);
+  EXPECT_EQ(j["hinf"]["modes"], "first");
+  // The Hankel values belong to the stable part: all states but the integrator and unstable poles
+  // (the truncation keeps those, so they are among the compensator's).
+  std::size_t unstable = 0;
+  for (const auto& p : c.full_order->controller_poles) unstable += p.real() > -1e-6 ? 1U : 0U;
+  EXPECT_EQ(j["hinf"]["hankel_singular_values"].size(), 9U - unstable);
   EXPECT_EQ(j["structure"], "hinf");
   EXPECT_EQ(j["loop"], "velocity");
   const LoadedController back = parse_controller_json(j.dump(), "hinf.json");
@@ -689,6 +700,18 @@ TEST_F(ControllerJsonErrors, HinfDocuments) {
   expect(edited([](auto& c) { c["hinf"]["controller_poles"][0][0] = 99.0; }), "hinf.controller_poles[0]",
          "not an eigenvalue");
   expect(edited([](auto& c) { c["hinf"]["compensator"]["B"][1][1] = 7.0; }), "state_space", "does not realize");
+  expect(edited([](auto& c) { c["hinf"]["modes"] = "both"; }), "hinf.modes", "\"active\"");
+  expect(edited([](auto& c) { c["hinf"]["full_order"] = 3; }), "hinf.full_order", ">= the compensator's 5");
+  expect(edited([](auto& c) { c["hinf"]["full_order"] = 9.5; }), "hinf.full_order", "whole number");
+  expect(edited([](auto& c) { c["hinf"]["hankel_singular_values"][1] = 1e9; }), "hinf.hankel_singular_values[1]",
+         "descending");
+  expect(edited([](auto& c) { c["hinf"]["reduction_error_bound"] = -1.0; }), "hinf.reduction_error_bound", ">= 0");
+  // Files written before C7.16 (no modes, order or Hankel values) read as a first-mode design.
+  EXPECT_EQ(edited([](auto& c) {
+              for (const char* k : {"modes", "full_order", "hankel_singular_values", "reduction_error_bound"})
+                c["hinf"].erase(k);
+            }).message,
+            "no error");
   expect(edited([](auto& c) { c["lqg"] = c["hinf"]; }), "lqg", "only lqg and lqg+p controllers");
   expect(with([](auto& c) { c["hinf"] = {{"omega_0s", 1.0}}; }), "hinf", "only hinf controllers");
 }

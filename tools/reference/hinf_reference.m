@@ -12,6 +12,19 @@ s = tf('s');
 
 cases = {};
 
+% The generalized plant [z1; z2; e] = [W1 (Pe u + V w); W2 u; -(Pe u + V w)] from one shared
+% realization of [V Pe] (n states: the open-loop poles) and W2. Assembled by blocks: a minreal of
+% the stacked system kept duplicate integrators.
+function P = assemble(V, Pe, W2, Ms, n)
+  G = minreal(ss([V Pe]));
+  assert(rows(G.a) == n);
+  [ag, bg, cg, dg] = ssdata(G);
+  [aw, bw, cw, dw] = ssdata(ss(W2));
+  nw = rows(aw);
+  P = ss(blkdiag(ag, aw), [bg; zeros(nw, 1), bw], ...
+         [cg/Ms, zeros(1, nw); zeros(1, n), cw; -cg, zeros(1, nw)], [dg/Ms; 0, dw; -dg]);
+end
+
 % C7.14 velocity mixed sensitivity on a normalized two-mass plant: Pe = Pm/s,
 % z = [W1 y; W2 u], y_meas = -(Pe u + V w); the weights as printed (catalog C7.14), V's
 % denominator = Pe's (the open-loop poles), built here from transfer functions, independently of
@@ -24,14 +37,7 @@ function P = velocity_plant(r, zz, zp, a, w0S, w0T, xv, Ms, Mt)
   Pe = N/den;
   V = (s + w0S)^2*(s^2 + 2*xv*r*s + r^2)/den;
   W2 = (1/Mt)*(s + w0T)^2*(s + r)^2/((s + w0S)^2*(s^2 + 2*xv*r*s + r^2)*(w0T*r)^2);
-  G = minreal(ss([V Pe]));              % one shared realization of the open-loop poles
-  assert(rows(G.a) == 4);
-  [ag, bg, cg, dg] = ssdata(G);
-  [aw, bw, cw, dw] = ssdata(ss(W2));
-  nw = rows(aw);
-  % Assembled by blocks: a minreal of the stacked system kept duplicate integrators here.
-  P = ss(blkdiag(ag, aw), [bg; zeros(nw, 1), bw], ...
-         [cg/Ms, zeros(1, nw); zeros(1, 4), cw; -cg, zeros(1, nw)], [dg/Ms; 0, dw; -dg]);
+  P = assemble(V, Pe, W2, Ms, 4);
 end
 
 % C7.14's position weights: Pe = Pm/s^2, cubes of (s + w0S) and (s + w0T) (catalog C7.14).
@@ -43,13 +49,35 @@ function P = position_plant(r, zz, zp, a, w0S, w0T, xv, Ms, Mt)
   Pe = N/den;
   V = (s + w0S)^3*(s^2 + 2*xv*r*s + r^2)/den;
   W2 = (1/Mt)*(s + w0T)^3*(s + r)^2/((s + w0S)^3*(s^2 + 2*xv*r*s + r^2)*(w0T^3*r^2));
-  G = minreal(ss([V Pe]));
-  assert(rows(G.a) == 5);
-  [ag, bg, cg, dg] = ssdata(G);
-  [aw, bw, cw, dw] = ssdata(ss(W2));
-  nw = rows(aw);
-  P = ss(blkdiag(ag, aw), [bg; zeros(nw, 1), bw], ...
-         [cg/Ms, zeros(1, nw); zeros(1, 5), cw; -cg, zeros(1, nw)], [dg/Ms; 0, dw; -dg]);
+  P = assemble(V, Pe, W2, Ms, 5);
+end
+
+% Catalog C7.16 (Sec. 7.4, eq. 7.165): two modes, the second with unit DC gain
+% (w2^2/wz2^2)(s^2 + 2 zz2 wz2 s + wz2^2)/(s^2 + 2 z2 w2 s + w2^2). Passive: V as for one mode (so
+% the controller may cancel mode 2); active: V with mode 2 relocated to damping xv (eq. 7.164).
+function P = two_mode_plant(active, r, zz, zp, wz2, zz2, w2, z2, w0S, w0T, xv, Ms, Mt)
+  s = tf('s');
+  N = (s^2 + 2*zz*s + 1)*(w2^2/wz2^2)*(s^2 + 2*zz2*wz2*s + wz2^2);
+  D1 = s^2 + 2*zp*r*s + r^2;
+  D2 = s^2 + 2*z2*w2*s + w2^2;
+  den = s^2*D1*D2;
+  Pe = N/den;
+  if active
+    V = (s + w0S)^2*(s^2 + 2*xv*r*s + r^2)*(s^2 + 2*xv*w2*s + w2^2)/den;
+  else
+    V = (s + w0S)^2*(s^2 + 2*xv*r*s + r^2)/(s^2*D1);
+  end
+  W2 = (1/Mt)*(s + w0T)^2*(s + r)^2/((s + w0S)^2*(s^2 + 2*xv*r*s + r^2)*(w0T*r)^2);
+  P = assemble(V, Pe, W2, Ms, 6);
+end
+
+modes = {struct('name', 'two_modes_passive', 'active', 0), struct('name', 'two_modes_active', 'active', 1)};
+for i = 1:numel(modes)
+  m = modes{i};
+  w = struct('r', 4, 'zz', 0.01, 'zp', 0.04, 'a', 0, 'wz2', 6, 'zz2', 0.01, 'w2', 12, 'z2', 0.02, ...
+             'w0S', 1, 'w0T', 4, 'xv', 0.8, 'Ms', 1.5, 'Mt', 1.5, 'active', m.active);
+  P = two_mode_plant(m.active, w.r, w.zz, w.zp, w.wz2, w.zz2, w.w2, w.z2, w.w0S, w.w0T, w.xv, w.Ms, w.Mt);
+  cases{end+1} = struct('name', m.name, 'P', P, 'nmeas', 1, 'ncon', 1, 'weights', w);
 end
 
 vel = {struct('name', 'velocity_r2', 'r', 2, 'zz', 0.01, 'zp', 0.02, 'a', 0, 'w0S', 0.5, 'w0T', 2, 'xv', 0.8, 'Ms', 1.5, 'Mt', 1.5), ...

@@ -30,12 +30,34 @@ C = [1 0 1 0 0.5; 0 1 0 0.3 1];
 D = [0 0.1; 0 0];
 cases{end+1} = struct('name', 'mimo', 'sys', ss(A, B, C, D), 'orders', [2 3]);
 
+% The reduced-order H-infinity controller printed for the flexible frame (catalog C7.19):
+% K(s) = -0.067 (s - 146)(s + 0.27)(s^2 + 0.52 s + 2.02) / (s (s^2 - 0.96 s + 2.9)(s^2 + 22.35 s + 274.2)),
+% with an integrator and an unstable pair: btamodred keeps the 3 poles right of its default
+% boundary -sqrt(eps) and reduces the stable pair.
+K = zpk([146; -0.27; roots([1 0.52 2.02])], [0; roots([1 -0.96 2.9]); roots([1 22.35 274.2])], -0.067);
+K = ss(K);
+cases{end+1} = struct('name', 'c7_19_controller', 'sys', K, 'orders', [3 4], 'unstable', 3);
+
+% The same controller in series with two lightly damped stable modes (9 states, 6 stable).
+M = tf([1 0.2 9], [1 0.6 9]) * tf([1 0.4 40], [1 2 40]);
+cases{end+1} = struct('name', 'unstable_with_modes', 'sys', ss(K * M), 'orders', [4 5 7], 'unstable', 3);
+
 omega = logspace(-1, 2, 13);
 out = {};
 for i = 1:numel(cases)
   cs = cases{i};
   [a, b, cc, dd] = ssdata(cs.sys);
-  entry = struct('name', cs.name, 'A', a, 'B', b, 'C', cc, 'D', dd, 'hsv', hsvd(cs.sys)', 'omega', omega);
+  if isfield(cs, 'unstable')
+    % hsvd of an unstable system gives its stable part's values (unstable ones reported as Inf).
+    hsv = hsvd(cs.sys);
+    hsv = hsv(isfinite(hsv))';
+    unstable = cs.unstable;
+  else
+    hsv = hsvd(cs.sys)';
+    unstable = 0;
+  end
+  entry = struct('name', cs.name, 'A', a, 'B', b, 'C', cc, 'D', dd, 'hsv', hsv, 'unstable', unstable, ...
+                 'states', size(a, 1), 'omega', omega);
   reduced = {};
   for nr = cs.orders
     Gr = btamodred(cs.sys, nr, 'method', 'sr');

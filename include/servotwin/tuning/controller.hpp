@@ -20,6 +20,7 @@
 
 #include "servotwin/core/state_space.hpp"
 #include "servotwin/tuning/loop_analysis.hpp"
+#include "servotwin/tuning/hinf.hpp"
 #include "servotwin/tuning/lqg.hpp"
 #include "servotwin/tuning/normalized_plant.hpp"
 #include "servotwin/tuning/pi_design.hpp"
@@ -75,6 +76,10 @@ struct HinfSummary {
   double gamma_optimal = 0.0;      ///< optimal gamma of the weighted problem
   double gamma = 0.0;              ///< gamma of the controller (gamma_optimal times the backoff)
   std::string omega_0s_source;     ///< "given", or what limited the automatic w0S
+  ModeHandling modes = ModeHandling::kFirstMode;  ///< how the design treated higher modes (C7.16)
+  int full_order = 0;              ///< states of K = K0/s before the reduction (the compensator has fewer)
+  std::vector<double> hankel;      ///< Hankel singular values of K's stable part, descending
+  double reduction_error_bound = 0.0;  ///< ||K_full - K||_inf bound of the reduction (0: none)
 };
 
 /// A full-order (LQG or H-infinity) design, normalized units (C7.13, C7.14).

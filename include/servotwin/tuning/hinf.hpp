@@ -25,14 +25,23 @@
 ///   V  = (s + w0S)^3 (s^2 + 2 xi_v r s + r^2) / den(Pe);
 /// K = K0/s maps the position error to the torque.
 ///
-/// The design model is the first mode's two-mass plant Pm (normalized_plant.hpp) without higher
-/// modes, times the plant's known HF dynamics (hf: current lag, lag, measurement filter, and the
-/// delay as its first-order Padé approximant (1 - sT/2)/(1 + sT/2)); V's numerator gets the same
-/// extra poles, so its shape is unchanged. The tuner evaluates the loop with the exact delay and
-/// the higher modes.
+/// The design model is Pm (normalized_plant.hpp) times the plant's known HF dynamics (hf: current
+/// lag, lag, measurement filter, and the delay as its first-order Padé approximant
+/// (1 - sT/2)/(1 + sT/2)); V's numerator gets the same extra poles, so its shape is unchanged.
+/// The higher modes of a multi-mode plant (C7.16, approach B) enter as `modes` says:
+///   kFirstMode  left out (approach A: design on mode 1, the tuner checks on the full plant);
+///   kPassive    in Pe, V unchanged: V's numerator carries their lightly damped poles, so the
+///               controller cancels them (a notch: passive, "gain" stabilization) and actively
+///               damps mode 1 only; 2 controller states per mode;
+///   kActive     in Pe, and V extended as eq. 7.164: each higher pair relocated to damping xi_v at
+///               its own frequency, V = (s + w0S)^2 (s^2 + 2 xi_v r s + r^2) prod(s^2 + 2 xi_v wi s + wi^2) / den(Pe),
+///               so the loop damps every mode actively (at a higher HF controller gain).
+/// W2 is the same in all three. The tuner evaluates the loop with the exact delay and the higher
+/// modes.
 
 #include <complex>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "servotwin/core/state_space.hpp"
@@ -44,6 +53,14 @@ namespace servotwin::tuning {
 /// sqrt(2)/2 passes.
 inline constexpr double kXiVMin = 0.7, kXiVMax = 1.0;
 
+/// How a design treats the higher modes of a multi-mode plant (C7.16; see above).
+enum class ModeHandling { kFirstMode, kPassive, kActive };
+
+/// "first", "passive", "active".
+[[nodiscard]] const char* to_string(ModeHandling m) noexcept;
+/// The inverse of to_string; std::nullopt for anything else.
+[[nodiscard]] std::optional<ModeHandling> parse_mode_handling(const std::string& text) noexcept;
+
 /// C7.14's weights (normalized frequencies), for the velocity and the position designs.
 struct VelocityHinfWeights {
   double omega_0s = 0.5;            ///< w0S: dominant closed-loop pole pair (> 0)
@@ -52,6 +69,16 @@ struct VelocityHinfWeights {
   double ms = 1.5;                  ///< W1 = 1/Ms
   double mt = 1.5;                  ///< the 1/Mt of W2
   double backoff = 1.01;            ///< controller at gamma_opt * backoff (core::HinfOptions)
+  ModeHandling modes = ModeHandling::kFirstMode;  ///< higher modes (C7.16); no effect on a two-mass plant
+  /// Reduce the compensator K to this many states by balanced truncation of its stable part
+  /// (core::balanced_truncation_stable_part: the integrator and any unstable poles are kept).
+  /// std::nullopt gives K's minimal realization: only the states of Hankel singular value near
+  /// rounding level (<= 1e-6 of the largest: W2's poles, which K cancels) are dropped, so a
+  /// two-mass velocity controller has 5 states and each higher mode adds 2 (C7.14, C7.16).
+  std::optional<int> controller_order;
+  /// false (with no controller_order): K at its full order, without the Hankel values: a search
+  /// that only needs K's response saves the split and the Gramians.
+  bool minimal_realization = true;
 };
 
 /// A designed H-infinity velocity controller (normalized units).
@@ -65,18 +92,26 @@ struct HinfDesign {
   double omega_0t = 0.0;               ///< the w0T used
   std::vector<std::complex<double>> controller_poles;  ///< eig of the compensator (one integrator at 0)
   bool controller_stable = false;      ///< stable except the integrator (stable_except_integrator)
+  int full_order = 0;                  ///< states of K before any reduction (the generalized plant's + 1)
+  /// Hankel singular values of K's stable part (descending; what a reduction would discard), and
+  /// the bound 2 sum(discarded) on ||K - K_reduced||_inf (0 when nothing was dropped).
+  std::vector<double> hankel;
+  double reduction_error_bound = 0.0;
 };
 
-/// The generalized plant above for the first mode of `plant` with its HF dynamics (higher modes
-/// left out; 8 states plus one per HF factor). core::InputError (field "omega_0s", "omega_0t", "xi_v", "ms", "mt") for weights out of
-/// range; plant checks as in normalized_two_mass().
+/// The generalized plant above for `plant` with its HF dynamics and, unless weights.modes is
+/// kFirstMode, its higher modes (8 states, plus one per HF factor and two per higher mode).
+/// core::InputError (field "omega_0s", "omega_0t", "xi_v", "ms", "mt", "controller_order") for
+/// weights out of range; plant checks as in normalized_two_mass().
 [[nodiscard]] core::StateSpace velocity_mixed_sensitivity_plant(const NormalizedPlant& plant,
                                                                 const VelocityHinfWeights& weights);
 
 /// The C7.14 velocity design: the generalized plant, core::hinf_synthesis (relative tolerance
 /// 1e-4, the weights' backoff), K = K0/s in the tuner's two-input form. Throws core::InputError as
-/// velocity_mixed_sensitivity_plant and for a backoff outside [1, 10]; std::domain_error when the
-/// synthesis finds no controller (not expected for valid weights: the problem is always solvable).
+/// velocity_mixed_sensitivity_plant and for a backoff outside [1, 10] or a controller_order below the
+/// compensator's unstable states (the integrator included) or above its full order;
+/// std::domain_error when the synthesis finds no controller (not expected for valid weights: the
+/// problem is always solvable).
 [[nodiscard]] HinfDesign velocity_hinf(const NormalizedPlant& plant, const VelocityHinfWeights& weights);
 
 /// The position loop's generalized plant (Pe = Pm/s^2, cubic weights; 10 states plus one per HF

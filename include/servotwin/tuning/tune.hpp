@@ -73,6 +73,13 @@ struct TuneOptions {
   /// hinf: w0T (normalized); std::nullopt: r, raised to 2r, 4r, 8r while the spec fails (C7.14).
   std::optional<double> omega_0t;
   double xi_v = 0.8;  ///< hinf: damping of the relocated resonant pair, [0.707, 1]
+  /// hinf on a plant with higher modes (C7.16): kActive designs on the full model and damps every
+  /// mode; kPassive designs on it and cancels the higher ones (a notch); kFirstMode designs on
+  /// mode 1 and only checks the full model. No effect on a two-mass plant.
+  ModeHandling hinf_modes = ModeHandling::kActive;
+  /// hinf: the compensator's states after balanced truncation (the search designs every candidate
+  /// at this order); std::nullopt: the minimal realization (VelocityHinfWeights::controller_order).
+  std::optional<int> controller_order;
 };
 
 /// Everything the tuner found, for the CLI summary, the controller file and the report.
