@@ -112,16 +112,36 @@ core::StateSpace shared_realization(const Polynomial& den, const Polynomial& num
   return g;
 }
 
+/// Which velocity the loop measures: the motor's (C7.14) or the load's (C7.17).
+enum class Sensor { kMotor, kLoad };
+
+/// The plant's numerator over (s + a)(s^2 + 2 zeta_p r s + r^2): the motor's antiresonance, or the
+/// load's coupling b/k s + 1 of the two-mass realization (InputError without one).
+Polynomial measured_numerator(const NormalizedPlant& plant, Sensor sensor) {
+  if (sensor == Sensor::kMotor) return Polynomial{1.0, 2.0 * plant.zeta_z, 1.0};
+  if (!plant.higher_modes.empty())
+    throw core::InputError(core::at_field("plant"), "the load-side design (C7.17) needs a two-mass plant; this one has " +
+                                                         std::to_string(plant.higher_modes.size()) + " higher mode(s)");
+  const std::optional<core::TransferFunction> load = plant.load();
+  if (!load)
+    throw core::InputError(core::at_field("plant"),
+                           "the load-side design (C7.17) needs a two-mass realization, and this plant has none "
+                           "(its friction terms would be negative)");
+  return (1.0 / load->den().leading()) * load->num();
+}
+
 /// The generalized plant of C7.14 for the velocity (k = 2: Pe = Pm/s) or the position loop (k = 3:
-/// Pe = Pm/s^2), as documented in the header.
-core::StateSpace mixed_sensitivity_plant(const NormalizedPlant& plant, const VelocityHinfWeights& weights, int k) {
+/// Pe = Pm/s^2), or of C7.17 for the load velocity (k = 2, Pe = Pl/s, W2's numerator (s + w0T)^4),
+/// as documented in the header.
+core::StateSpace mixed_sensitivity_plant(const NormalizedPlant& plant, const VelocityHinfWeights& weights, int k,
+                                         Sensor sensor = Sensor::kMotor) {
   check_weights(weights);
   detail::require_ratio(plant.r, "r");
   const double r = plant.r;
   const double w0s = weights.omega_0s;
   const double w0t = weights.omega_0t.value_or(r);
   // Pe = Pm/s^(k-1) = N / (s^(k-1) (s + a) D), Im = 1 (normalized_plant.hpp).
-  const Polynomial antiresonance{1.0, 2.0 * plant.zeta_z, 1.0};
+  const Polynomial numerator = measured_numerator(plant, sensor);
   const Polynomial resonance{1.0, 2.0 * plant.zeta_p * r, r * r};
   const ExtraDynamics extra = extra_dynamics(plant, weights);
   const Polynomial den = power(Polynomial{1.0, 0.0}, k - 1) * Polynomial{1.0, plant.a} * resonance * extra.hf_den *
@@ -131,11 +151,12 @@ core::StateSpace mixed_sensitivity_plant(const NormalizedPlant& plant, const Vel
   // the controller may cancel them) or relocates them (active, eq. 7.164).
   const Polynomial v_modes = weights.modes == ModeHandling::kActive ? extra.relocated : extra.modes_den;
   const core::StateSpace g =
-      shared_realization(den, target * extra.hf_den * v_modes, antiresonance * extra.hf_num * extra.modes_num);
+      shared_realization(den, target * extra.hf_den * v_modes, numerator * extra.hf_num * extra.modes_num);
 
   const Polynomial lead_t{1.0, w0t}, lead_r{1.0, r};
-  const core::TransferFunction w2((1.0 / (weights.mt * std::pow(w0t, k) * r * r)) * (power(lead_t, k) * lead_r * lead_r),
-                                  target);
+  // The load sees no antiresonance to notch: C7.17's W2 rolls off with (s + w0T)^4 alone.
+  const Polynomial w2_num = sensor == Sensor::kLoad ? power(lead_t, 4) : power(lead_t, k) * lead_r * lead_r;
+  const core::TransferFunction w2((1.0 / (weights.mt * std::pow(w0t, k) * r * r)) * w2_num, target);
   const core::StateSpace w = core::to_state_space(w2);
 
   const Eigen::Index ng = g.states(), nw = w.states();
@@ -216,9 +237,10 @@ void add_compensator(HinfDesign& d, std::optional<int> order, bool minimal) {
   d.controller_stable = stable_except_integrator(d.controller_poles);
 }
 
-HinfDesign design(const NormalizedPlant& plant, const VelocityHinfWeights& weights, int k) {
+HinfDesign design(const NormalizedPlant& plant, const VelocityHinfWeights& weights, int k,
+                  Sensor sensor = Sensor::kMotor) {
   HinfDesign d;
-  d.generalized_plant = mixed_sensitivity_plant(plant, weights, k);
+  d.generalized_plant = mixed_sensitivity_plant(plant, weights, k, sensor);
   d.omega_0t = weights.omega_0t.value_or(plant.r);
   core::HinfOptions options;
   options.backoff = weights.backoff;
@@ -250,6 +272,14 @@ std::optional<ModeHandling> parse_mode_handling(const std::string& text) noexcep
 
 core::StateSpace velocity_mixed_sensitivity_plant(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {
   return mixed_sensitivity_plant(plant, weights, 2);
+}
+
+core::StateSpace load_side_mixed_sensitivity_plant(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {
+  return mixed_sensitivity_plant(plant, weights, 2, Sensor::kLoad);
+}
+
+HinfDesign load_side_hinf(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {
+  return design(plant, weights, 2, Sensor::kLoad);
 }
 
 core::StateSpace position_mixed_sensitivity_plant(const NormalizedPlant& plant, const VelocityHinfWeights& weights) {

@@ -2,12 +2,15 @@
 // tests/data/core/hinf_reference.json (tools/reference/hinf_reference.m): the generalized plant
 // built there from transfer-function objects (Octave's own realizations), its optimal gamma
 // (bisection over hinfsyn SUBOPTIMAL = SLICOT SB10FD) and the central controller at a fixed gamma;
-// and the mixed-sensitivity bound |S| <= gamma / |W1 V| that any solution must satisfy.
+// and the mixed-sensitivity bound |S| <= gamma / |W1 V| that any solution must satisfy. The
+// multi-mode (C7.16) and load-side (C7.17) variants are checked the same way against Octave, and
+// against the findings their sections print.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <map>
 #include <string>
 
 #include "json_fixture.hpp"
@@ -369,6 +372,98 @@ TEST(MultiModeHinf, ControllerOrdersAndBalancedTruncation) {
     ADD_FAILURE() << "order 4 accepted";
   } catch (const core::InputError& e) {
     EXPECT_EQ(e.where().field, "controller_order");
+  }
+}
+
+// ------------------------------------------------------------------ C7.17 load-side feedback
+
+TEST(LoadSideHinf, GeneralizedPlantGammaAndControllerMatchOctave) {
+  const nlohmann::json* found = nullptr;
+  for (const auto& c : reference()["cases"])
+    if (c["name"] == "load_side_r3") found = &c;
+  ASSERT_NE(found, nullptr);
+  const nlohmann::json& c = *found;
+  const auto& w = c["weights"];
+  const NormalizedPlant plant = normalized_two_mass(w["r"].get<double>(), w["zz"].get<double>());
+  VelocityHinfWeights weights = weights_of(c, ModeHandling::kFirstMode);
+  const core::StateSpace p = load_side_mixed_sensitivity_plant(plant, weights);
+  ASSERT_EQ(p.states(), 8);
+  const auto n = c["states"].get<Eigen::Index>();
+  const core::StateSpace octave{test_support::octave_matrix(c["A"], n, n), test_support::octave_matrix(c["B"], n, 2),
+                                test_support::octave_matrix(c["C"], 3, n), test_support::octave_matrix(c["D"], 3, 2)};
+  for (const double omega : {0.01, 0.5, 1.0, 2.9, 3.0, 10.0, 100.0}) {
+    const Eigen::MatrixXcd expected = core::frequency_response(octave, omega);
+    EXPECT_LT((core::frequency_response(p, omega) - expected).norm(), 1e-9 * expected.norm()) << "omega " << omega;
+  }
+  const HinfDesign d = load_side_hinf(plant, weights);
+  EXPECT_LE(d.gamma_optimal, c["gamma_optimal"].get<double>() * (1.0 + 1.1e-4));
+  EXPECT_GE(d.gamma_optimal, c["gamma_optimal"].get<double>() * (1.0 - 1e-4));
+  const auto k0 = core::hinf_central_controller(p, 1, 1, c["gamma_suboptimal"].get<double>());
+  ASSERT_TRUE(k0.has_value());
+  const auto& omega = c["omega"];
+  for (std::size_t i = 0; i < omega.size(); ++i) {
+    const std::complex<double> expected(c["K_re"][i].get<double>(), c["K_im"][i].get<double>());
+    EXPECT_LT(std::abs(core::frequency_response(k0->controller, omega[i].get<double>(), 0, 0) - expected),
+              1e-6 * std::abs(expected));
+  }
+}
+
+/// The load-side loop of a design: K (first input of the compensator) on Pl = plant.load().
+struct LoadLoop {
+  double peak_s = 0.0, peak_t = 0.0, bandwidth = 0.0, hf_gain = 0.0;
+  bool stable = false;
+};
+
+LoadLoop load_loop(const NormalizedPlant& plant, const HinfDesign& d) {
+  const core::TransferFunction pl = *plant.load();
+  core::StateSpace k = d.compensator;  // column 0: u = K (w* - wl)
+  k.B = d.compensator.B.col(0);
+  k.D = d.compensator.D.col(0);
+  const core::StateSpace open = core::series(k, core::to_state_space(pl));
+  const core::StateSpace unity{Eigen::MatrixXd(0, 0), Eigen::MatrixXd(0, 1), Eigen::MatrixXd(1, 0), Eigen::MatrixXd::Ones(1, 1)};
+  const core::StateSpace closed = core::feedback(open, unity);
+  LoadLoop out;
+  out.stable = true;
+  for (const auto& p : Eigen::VectorXcd(closed.A.eigenvalues())) out.stable = out.stable && p.real() < 0.0;
+  for (double omega = 1e-3; omega < 1e3; omega *= 1.01) {
+    const std::complex<double> l = core::frequency_response(k, omega, 0, 0) * pl.frequency_response(omega);
+    const double t = std::abs(l / (1.0 + l));
+    out.peak_s = std::max(out.peak_s, std::abs(1.0 / (1.0 + l)));
+    out.peak_t = std::max(out.peak_t, t);
+    if (out.bandwidth == 0.0 && t < std::sqrt(0.5)) out.bandwidth = omega;
+  }
+  out.hf_gain = std::abs(core::frequency_response(k, 100.0, 0, 0));
+  return out;
+}
+
+TEST(LoadSideHinf, C717DemoMeetsThePeakLimitsAndPaysInControllerGain) {
+  // C7.17's demo: w0S in {1, 2, 5, 10} rad/s (normalized: omega_z = 1), w0T raised from r until
+  // ||S||, ||Tl|| <= 1.8. Measuring the load removes the antiresonance limit: the bandwidth grows
+  // with w0S past the resonance, and the HF controller gain grows much faster ("a bandwidth >> wn
+  // needs a huge HF controller gain").
+  const NormalizedPlant plant = normalized_two_mass(3.0, 0.01);
+  VelocityHinfWeights w;
+  w.ms = 1.8;
+  w.mt = 1.8;
+  std::map<double, LoadLoop> met;
+  for (const double w0s : {1.0, 2.0, 5.0, 10.0}) {
+    w.omega_0s = w0s;
+    for (int step = 0; step < 5 && !met.count(w0s); ++step) {
+      w.omega_0t = std::max(plant.r, w0s) * std::ldexp(1.0, step);
+      const LoadLoop l = load_loop(plant, load_side_hinf(plant, w));
+      if (l.stable && l.peak_s <= w.ms && l.peak_t <= w.mt) met[w0s] = l;
+    }
+    ASSERT_TRUE(met.count(w0s)) << "no w0T meets the limits at w0S = " << w0s;
+  }
+  // Measured: |K(j100)| = 28 (w0S = 1, w0T = 12), 17 (2, 6), 142 (5, 10), 1510 (10, 20).
+  EXPECT_GT(met[10.0].hf_gain, 50.0 * met[1.0].hf_gain);
+  EXPECT_GT(met[5.0].hf_gain, 3.0 * met[1.0].hf_gain);
+  // A modal model has no load to measure.
+  try {
+    (void)load_side_hinf(two_mode_plant(), w);
+    ADD_FAILURE() << "a two-mode plant accepted";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.where().field, "plant");
   }
 }
 

@@ -71,6 +71,23 @@ function P = two_mode_plant(active, r, zz, zp, wz2, zz2, w2, z2, w0S, w0T, xv, M
   P = assemble(V, Pe, W2, Ms, 6);
 end
 
+% Catalog C7.17: load-side feedback, Pel = (1/s^2)(2 zz s + 1)/(s^2 + 2 zz r^2 s + r^2) (the
+% frictionless two-mass load velocity with the integral action), V as for the motor, and
+% W2 = (1/Mt)(s + w0T)^4/[(s + w0S)^2 (s^2 + 2 xv r s + r^2)(w0T r)^2].
+function P = load_side_plant(r, zz, w0S, w0T, xv, Ms, Mt)
+  s = tf('s');
+  D = s^2 + 2*zz*r^2*s + r^2;
+  den = s^2*D;
+  Pe = (2*zz*s + 1)/den;
+  V = (s + w0S)^2*(s^2 + 2*xv*r*s + r^2)/den;
+  W2 = (1/Mt)*(s + w0T)^4/((s + w0S)^2*(s^2 + 2*xv*r*s + r^2)*(w0T*r)^2);
+  P = assemble(V, Pe, W2, Ms, 4);
+end
+
+ls = struct('name', 'load_side_r3', 'r', 3, 'zz', 0.01, 'zp', 0.03, 'a', 0, 'w0S', 2, 'w0T', 6, 'xv', 0.8, 'Ms', 1.8, 'Mt', 1.8);
+cases{end+1} = struct('name', ls.name, 'P', load_side_plant(ls.r, ls.zz, ls.w0S, ls.w0T, ls.xv, ls.Ms, ls.Mt), ...
+                      'nmeas', 1, 'ncon', 1, 'weights', ls);
+
 modes = {struct('name', 'two_modes_passive', 'active', 0), struct('name', 'two_modes_active', 'active', 1)};
 for i = 1:numel(modes)
   m = modes{i};

@@ -25,6 +25,12 @@
 ///   V  = (s + w0S)^3 (s^2 + 2 xi_v r s + r^2) / den(Pe);
 /// K = K0/s maps the position error to the torque.
 ///
+/// Load-side feedback (C7.17): the loop measures the load velocity wl, Pe = Pl/s with
+/// Pl = (b/k s + 1)/((s + a)(s^2 + 2 zeta_p r s + r^2)) the two-mass realization's load velocity per
+/// torque (printed, frictionless: Pel = (1/s^2)(2 zeta_z s + 1)/(s^2 + 2 zeta_z r^2 s + r^2)), V as
+/// for the motor, and W2 = (1/Mt) (s + w0T)^4 / [(s + w0S)^2 (s^2 + 2 xi_v r s + r^2) (w0T r)^2]:
+/// there is no antiresonance to keep out of the loop.
+///
 /// The design model is Pm (normalized_plant.hpp) times the plant's known HF dynamics (hf: current
 /// lag, lag, measurement filter, and the delay as its first-order Padé approximant
 /// (1 - sT/2)/(1 + sT/2)); V's numerator gets the same extra poles, so its shape is unchanged.
@@ -113,6 +119,16 @@ struct HinfDesign {
 /// std::domain_error when the synthesis finds no controller (not expected for valid weights: the
 /// problem is always solvable).
 [[nodiscard]] HinfDesign velocity_hinf(const NormalizedPlant& plant, const VelocityHinfWeights& weights);
+
+/// The load-side generalized plant of C7.17 (8 states plus the HF factors). Errors as
+/// velocity_mixed_sensitivity_plant, and core::InputError (field "plant") for a plant with higher
+/// modes or without a two-mass realization (negative friction terms).
+[[nodiscard]] core::StateSpace load_side_mixed_sensitivity_plant(const NormalizedPlant& plant,
+                                                                 const VelocityHinfWeights& weights);
+
+/// The C7.17 load-side design: K = K0/s with inputs [w*, wl] (the load velocity), output torque.
+/// Errors as load_side_mixed_sensitivity_plant and velocity_hinf.
+[[nodiscard]] HinfDesign load_side_hinf(const NormalizedPlant& plant, const VelocityHinfWeights& weights);
 
 /// The position loop's generalized plant (Pe = Pm/s^2, cubic weights; 10 states plus one per HF
 /// factor). Same errors as velocity_mixed_sensitivity_plant.
