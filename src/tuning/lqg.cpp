@@ -46,47 +46,49 @@ Eigen::RowVectorXd regulator(const Matrix& a, const Matrix& b, const Matrix& q, 
   return (b.transpose() * x).row(0) / rho;
 }
 
-/// The Kalman gain L = Y Cᵀ V⁻¹ of the filter CARE (scalar output).
-Eigen::VectorXd estimator(const Matrix& a, const Matrix& c, const Matrix& w, double v, double& residual) {
+/// The Kalman gain L = Y Cᵀ V⁻¹ of the filter CARE (one column per measurement).
+Matrix estimator(const Matrix& a, const Matrix& c, const Matrix& w, const Matrix& v, double& residual) {
   core::CareReport report;
-  const Matrix y = core::solve_care_filter(a, c, w, Matrix::Constant(1, 1, v), &report);
+  const Matrix y = core::solve_care_filter(a, c, w, v, &report);
   residual = std::max(residual, report.relative_residual);
-  return (y * c.transpose()).col(0) / v;
+  return y * c.transpose() * v.inverse();
 }
 
 /// Plant + compensator closed loop (reference and load torque set to zero): its poles. The
-/// compensator's measurement channel u = K_y y carries its own sign: positive feedback.
+/// compensator's measurement channels u = K_y y carry their own sign: positive feedback.
 std::vector<Complex> closed_loop_poles(const core::StateSpace& plant, const core::StateSpace& c) {
-  const core::StateSpace torque_to_measurement{plant.A, plant.B.col(0), plant.C.row(0), plant.D.block(0, 0, 1, 1)};
-  const core::StateSpace measurement_to_torque{c.A, c.B.col(1), c.C, c.D.col(1)};
+  const Eigen::Index m = c.B.cols() - 1;  // measurements: the plant's first m outputs
+  const core::StateSpace torque_to_measurement{plant.A, plant.B.col(0), plant.C.topRows(m), plant.D.block(0, 0, m, 1)};
+  const core::StateSpace measurement_to_torque{c.A, c.B.rightCols(m), c.C, c.D.rightCols(m)};
   return poles_of(core::feedback(torque_to_measurement, measurement_to_torque, +1).A);
 }
 
-/// The estimator's model: the plant's states plus a constant load torque, input Tm, output y.
+/// The estimator's model: the plant's states plus a constant load torque, input Tm, outputs the
+/// plant's first `measurements` outputs.
 struct EstimatorModel {
   Matrix a, b, c;
 };
-EstimatorModel estimator_model(const core::StateSpace& p) {
+EstimatorModel estimator_model(const core::StateSpace& p, Eigen::Index measurements = 1) {
   const Eigen::Index n = p.A.rows();
-  EstimatorModel e{Matrix::Zero(n + 1, n + 1), Matrix::Zero(n + 1, 1), Matrix::Zero(1, n + 1)};
+  EstimatorModel e{Matrix::Zero(n + 1, n + 1), Matrix::Zero(n + 1, 1), Matrix::Zero(measurements, n + 1)};
   e.a.topLeftCorner(n, n) = p.A;
   e.a.block(0, n, n, 1) = p.B.col(1);
   e.b.topRows(n) = p.B.col(0);
-  e.c.leftCols(n) = p.C.row(0);
+  e.c.leftCols(n) = p.C.topRows(measurements);
   return e;
 }
 
-/// Regulator on the plant's states plus the integral of −y (xi' = reference − y at run time) and
-/// estimator on the plant's states plus a constant load torque (y = first output); the design's
-/// gains and pole sets. `q` is the diagonal of Q over [plant states, xi]; `w` the process-noise
-/// intensity over [plant states, Tl].
+/// Regulator on the plant's states plus the integral of −y_i (xi' = reference − y_i at run time,
+/// i = `integral_output`) and estimator on the plant's states plus a constant load torque (the
+/// model's measurements); the design's gains and pole sets. `q` is the diagonal of Q over [plant
+/// states, xi]; `w` the process-noise intensity over [plant states, Tl]; `v` the measurement noise's.
 LqgDesign regulator_and_estimator(const core::StateSpace& p, const EstimatorModel& e, const Eigen::VectorXd& q,
-                                  double rho, const Matrix& w, double v) {
+                                  double rho, const Matrix& w, const Matrix& v, Eigen::Index integral_output = 0) {
   const Eigen::Index n = p.A.rows();
   LqgDesign d;
   Matrix a = Matrix::Zero(n + 1, n + 1);
   a.topLeftCorner(n, n) = p.A;
-  a.bottomLeftCorner(1, n) = -p.C.row(0);
+  a.bottomLeftCorner(1, n) = -p.C.row(integral_output);
   Matrix b = Matrix::Zero(n + 1, 1);
   b.topRows(n) = p.B.col(0);
   d.regulator_gain = regulator(a, b, q.asDiagonal().toDenseMatrix(), rho, d.riccati_residual);
@@ -96,11 +98,13 @@ LqgDesign regulator_and_estimator(const core::StateSpace& p, const EstimatorMode
   return d;
 }
 
-/// The compensator with states [x̂ (plant + Tl), xi], inputs [reference, y], output
-///   u = −kx x̂ − K_xi xi − ky y + kref·reference,
-/// x̂' = Ae x̂ + Be u + L (y − Ce x̂), xi' = reference − y; its poles and the closed loop's.
+/// The compensator with states [x̂ (plant + Tl), xi], inputs [reference, y (the model's
+/// measurements)], output
+///   u = −kx x̂ − K_xi xi − ky y₁ + kref·reference,
+/// x̂' = Ae x̂ + Be u + L (y − Ce x̂), xi' = reference − y_i (i = `integral_output`); its poles and
+/// the closed loop's.
 void finish(LqgDesign& d, const core::StateSpace& p, const EstimatorModel& e, const Eigen::RowVectorXd& kx, double ky,
-            double kref) {
+            double kref, Eigen::Index integral_output = 0) {
   const Eigen::Index ne = p.A.rows() + 1;
   const Matrix& ae = e.a;
   const Matrix& be = e.b;
@@ -110,20 +114,42 @@ void finish(LqgDesign& d, const core::StateSpace& p, const EstimatorModel& e, co
   c.A = Matrix::Zero(ne + 1, ne + 1);
   c.A.topLeftCorner(ne, ne) = ae - be * kx - d.estimator_gain * ce;
   c.A.block(0, ne, ne, 1) = -be * k_xi;
-  c.B = Matrix::Zero(ne + 1, 2);
+  const Eigen::Index m = ce.rows();
+  c.B = Matrix::Zero(ne + 1, 1 + m);
   c.B.block(0, 0, ne, 1) = be * kref;
-  c.B.block(0, 1, ne, 1) = d.estimator_gain - be * ky;
+  c.B.block(0, 1, ne, m) = d.estimator_gain;
+  c.B.block(0, 1, ne, 1) -= be * ky;
   c.B(ne, 0) = 1.0;
-  c.B(ne, 1) = -1.0;
+  c.B(ne, 1 + integral_output) = -1.0;
   c.C = Matrix::Zero(1, ne + 1);
   c.C.leftCols(ne) = -kx;
   c.C(0, ne) = -k_xi;
-  c.D.resize(1, 2);
-  c.D << kref, -ky;
+  c.D = Matrix::Zero(1, 1 + m);
+  c.D(0, 0) = kref;
+  c.D(0, 1) = -ky;
   d.controller_poles = poles_of(c.A);
   d.controller_stable = stable_except_integrator(d.controller_poles);
   d.closed_loop_poles = closed_loop_poles(p, c);
 }
+
+void check_velocity_options(const VelocityLqgOptions& o) {
+  detail::require_positive(o.kbw, "kbw", "the LQG bandwidth knob");
+  detail::require_positive(o.measurement_noise, "measurement_noise", "a measurement-noise intensity");
+  detail::require_non_negative(o.q_load_velocity, "q_load_velocity");
+  detail::require_non_negative(o.q_integral, "q_integral");
+  detail::require_non_negative(o.noise_motor, "noise_motor");
+  detail::require_non_negative(o.noise_load_torque, "noise_load_torque");
+  detail::require_non_negative(o.feedforward, "feedforward");
+}
+
+/// The velocity estimator's process noise: into ωm and the load torque.
+Matrix velocity_process_noise(const VelocityLqgOptions& o) {
+  Matrix w = Matrix::Zero(4, 4);
+  w(0, 0) = o.noise_motor;
+  w(3, 3) = o.noise_load_torque;
+  return w;
+}
+
 
 }  // namespace
 
@@ -160,28 +186,37 @@ core::StateSpace two_mass_state_space(const FrictionTwoMass& p, bool position) {
 
 LqgDesign velocity_lqg(const FrictionTwoMass& plant, double r, const VelocityLqgOptions& o) {
   check_plant(plant, r);
-  detail::require_positive(o.kbw, "kbw", "the LQG bandwidth knob");
-  detail::require_positive(o.measurement_noise, "measurement_noise", "a measurement-noise intensity");
-  detail::require_non_negative(o.q_load_velocity, "q_load_velocity");
-  detail::require_non_negative(o.q_integral, "q_integral");
-  detail::require_non_negative(o.noise_motor, "noise_motor");
-  detail::require_non_negative(o.noise_load_torque, "noise_load_torque");
-  detail::require_non_negative(o.feedforward, "feedforward");
-
+  check_velocity_options(o);
   const core::StateSpace p = two_mass_state_space(plant, false);
   const double rho = control_weight(o.kbw, r);
-  Matrix w = Matrix::Zero(4, 4);
-  w(0, 0) = o.noise_motor;
-  w(3, 3) = o.noise_load_torque;
+  const Matrix w = velocity_process_noise(o);
   const EstimatorModel e = estimator_model(p);
   LqgDesign d = regulator_and_estimator(p, e, Eigen::Vector4d(0.0, o.q_load_velocity, rho, o.q_integral), rho, w,
-                                        o.measurement_noise);
+                                        Matrix::Constant(1, 1, o.measurement_noise));
   // u = −K₁ x̂₁ − K₂ x̂₂ − K₃ x̂₃ − K₄ xi + kff ω* (K₁ on the measurement with raw_motor_velocity).
   Eigen::RowVectorXd kx = Eigen::RowVectorXd::Zero(4);
   kx.head(3) = d.regulator_gain.head(3);
   double ky = 0.0;
   if (o.raw_motor_velocity) std::swap(ky, kx(0));
   finish(d, p, e, kx, ky, o.feedforward);
+  return d;
+}
+
+LqgDesign load_side_lqg(const FrictionTwoMass& plant, double r, const VelocityLqgOptions& o) {
+  check_plant(plant, r);
+  check_velocity_options(o);
+  if (o.raw_motor_velocity)
+    throw core::InputError(core::at_field("raw_motor_velocity"), "not defined for the load-side LQG (C7.17)");
+  const core::StateSpace p = two_mass_state_space(plant, false);
+  const double rho = control_weight(o.kbw, r);
+  const EstimatorModel e = estimator_model(p, 2);  // ωm and ωl measured
+  constexpr Eigen::Index kLoadVelocity = 1;
+  LqgDesign d = regulator_and_estimator(p, e, Eigen::Vector4d(0.0, o.q_load_velocity, rho, o.q_integral), rho,
+                                        velocity_process_noise(o), o.measurement_noise * Matrix::Identity(2, 2),
+                                        kLoadVelocity);
+  Eigen::RowVectorXd kx = Eigen::RowVectorXd::Zero(4);
+  kx.head(3) = d.regulator_gain.head(3);
+  finish(d, p, e, kx, 0.0, o.feedforward, kLoadVelocity);
   return d;
 }
 
@@ -196,7 +231,8 @@ LqgDesign position_lqg(const FrictionTwoMass& plant, double r, const PositionLqg
   const double rho = control_weight(o.kbw, r);
   const EstimatorModel e = estimator_model(p);
   LqgDesign d =
-      regulator_and_estimator(p, e, o.q, rho, o.process_noise * Matrix::Identity(5, 5), o.measurement_noise);
+      regulator_and_estimator(p, e, o.q, rho, o.process_noise * Matrix::Identity(5, 5),
+                              Matrix::Constant(1, 1, o.measurement_noise));
   // Error coordinates: u = −K₁(φ̂m − φ*) − K₂ ω̂m − K₃(φ̂l − φ*) − K₄ ω̂l − K₅ xi, so that a step of φ*
   // acts at once and the integral only removes what the load torque leaves.
   Eigen::RowVectorXd kx = Eigen::RowVectorXd::Zero(5);

@@ -66,20 +66,26 @@ def cplx(z):
     return [[float(p.real), float(p.imag)] for p in z]
 
 
-def velocity_case(r, zz, kbw, bm=0.0, bl=0.0, raw=False, mt=1.5):
-    ap, bu, bt, il, k, b = plant(r, zz, bm, bl)
+def velocity_regulator(ap, bu, bt, r, kbw, integral_output):
+    """C7.13's velocity regulator with the integral on output 0 (wm) or 1 (wl): the augmented
+    (aa, ba), the estimator model's ae (plant + constant load torque), the gain and rho."""
     c = r * r / 2.0
     rho = kbw / c ** 2
     aa = np.zeros((4, 4))
     aa[:3, :3] = ap
-    aa[3, 0] = -1.0
+    aa[3, integral_output] = -1.0
     ba = np.vstack([bu, [[0.0]]])
-    q = np.diag([0.0, 20.0, kbw / c ** 2, 20.0])
-    kk = lqr(aa, ba, q, rho)
-    lqr_poles = np.linalg.eigvals(aa - ba @ kk)
+    kk = lqr(aa, ba, np.diag([0.0, 20.0, rho, 20.0]), rho)
     ae = np.zeros((4, 4))
     ae[:3, :3] = ap
     ae[:3, 3:4] = bt
+    return aa, ba, ae, kk, rho
+
+
+def velocity_case(r, zz, kbw, bm=0.0, bl=0.0, raw=False, mt=1.5):
+    ap, bu, bt, il, k, b = plant(r, zz, bm, bl)
+    aa, ba, ae, kk, rho = velocity_regulator(ap, bu, bt, r, kbw, 0)
+    lqr_poles = np.linalg.eigvals(aa - ba @ kk)
     be = np.vstack([bu, [[0.0]]])
     ce = np.array([[1.0, 0.0, 0.0, 0.0]])
     g = np.array([[1.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 1.0]])
@@ -176,6 +182,24 @@ def position_case(r, zz, kbw, bm=0.0, bl=0.0):
     }
 
 
+def load_side_case(r, zz, kbw, bm=0.0, bl=0.0):
+    """C7.17's LQG with load feedback: regulator on [wm, wl, Ts, xi] with xi' = w* - wl and the
+    velocity weights; Kalman filter on [wm, wl, Ts, Tl] measuring both velocities, W into wm and Tl
+    (1, 1), V = diag(0.1, 0.1)."""
+    ap, bu, bt, il, k, b = plant(r, zz, bm, bl)
+    aa, ba, ae, kk, rho = velocity_regulator(ap, bu, bt, r, kbw, 1)
+    ce = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
+    w = np.diag([1.0, 0.0, 0.0, 1.0])
+    v = 0.1 * np.eye(2)
+    y = linalg.solve_continuous_are(ae.T, ce.T, w, v)
+    l = y @ ce.T @ np.linalg.inv(v)
+    return {
+        "r": r, "zeta_z": zz, "kbw": kbw, "bm": bm, "bl": bl,
+        "K": kk[0].tolist(), "lqr_poles": cplx(np.linalg.eigvals(aa - ba @ kk)),
+        "L": l.tolist(), "kf_poles": cplx(np.linalg.eigvals(ae - l @ ce)),
+    }
+
+
 def peak(f):
     w = np.logspace(-3, 3, 200001)
     mags = np.array([abs(f(x)) for x in w[::50]])
@@ -196,10 +220,11 @@ def main():
         velocity_case(3.0, 0.01, 1.0, raw=True),
     ]
     position = [position_case(3.0, 0.01, 1.0), position_case(2.0, 0.02, 0.5, bm=0.05, bl=0.1)]
+    load_side = [load_side_case(3.0, 0.01, 1.0), load_side_case(5.0, 0.01, 0.3, bm=0.05, bl=0.1)]
     os.makedirs(os.path.dirname(OUT), exist_ok=True)
     with open(OUT, "w") as f:
-        json.dump({"generator": "tools/reference/tuning_lqg_reference.py", "velocity": velocity, "position": position},
-                  f, indent=1)
+        json.dump({"generator": "tools/reference/tuning_lqg_reference.py", "velocity": velocity, "position": position,
+                   "load_side": load_side}, f, indent=1)
     e29 = velocity[0]
     print("E29 K =", np.round(e29["K"], 3), "lqr |p| =", sorted(round(math.hypot(*p), 3) for p in e29["lqr_poles"]))
     print("E29 KF poles =", e29["kf_poles"])

@@ -16,6 +16,12 @@
 ///   u = −K₁ x̂₁ − K₂ x̂₂ − K₃ x̂₃ − K₄ xi + kff ω*   (x̂₁ replaced by the measured ωm with
 ///   raw_motor_velocity), x̂' = Ae x̂ + Be u + L (ωm − x̂₁), xi' = ω* − ωm.
 ///
+/// Load-side LQG (C7.17). The velocity regulator with the integral on the load, xi' = ω* − ωl, and
+/// the velocity weights ("cost unchanged": the doc points at eq. 7.137, the position weights, but
+/// this is the 4-state velocity model, so the velocity weights of C7.13 apply); the Kalman filter
+/// measures both velocities, y = [ωm, ωl], W as for the velocity LQG and V = diag(v, v) (printed
+/// 0.1). Compensator (5 states, inputs [ω*, ωm, ωl], output u).
+///
 /// Position LQG. Regulator on [φm, ωm, φl, ωl, xi], xi' = φ* − φm, Q = diag(1, 1, 20, 20, 5),
 /// R = kbw/c²; Kalman filter on [φm, ωm, φl, ωl, Tl] (the estimator model, eq. 7.138, is missing
 /// from the source, defect 19: the position model plus a constant load torque), y = φm, W = I₅,
@@ -60,7 +66,7 @@ struct PositionLqgOptions {
 /// A designed LQG compensator (normalized units).
 struct LqgDesign {
   Eigen::RowVectorXd regulator_gain;  ///< K (u = −K x)
-  Eigen::VectorXd estimator_gain;     ///< L
+  Eigen::MatrixXd estimator_gain;     ///< L (one column per measurement)
   std::vector<std::complex<double>> regulator_poles;   ///< eig(A − B K)
   std::vector<std::complex<double>> estimator_poles;   ///< eig(Ae − L Ce)
   std::vector<std::complex<double>> controller_poles;  ///< eig of the compensator
@@ -77,6 +83,9 @@ struct LqgDesign {
 /// The velocity LQG of C7.13. core::InputError (field named after the option) for weights that are
 /// not finite and > 0 (kff, q >= 0), or a plant without stiffness.
 [[nodiscard]] LqgDesign velocity_lqg(const FrictionTwoMass& plant, double r, const VelocityLqgOptions& options = {});
+
+/// The load-side LQG of C7.17 (the velocity options; raw_motor_velocity is refused: core::InputError).
+[[nodiscard]] LqgDesign load_side_lqg(const FrictionTwoMass& plant, double r, const VelocityLqgOptions& options = {});
 
 /// The position LQG of C7.13 (field names as above).
 [[nodiscard]] LqgDesign position_lqg(const FrictionTwoMass& plant, double r, const PositionLqgOptions& options = {});
