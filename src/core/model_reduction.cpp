@@ -136,16 +136,19 @@ StableSplit stable_split(const StateSpace& sys, double alpha) {
   return out;
 }
 
-BalancedTruncation balanced_truncation_stable_part(const StateSpace& sys, Eigen::Index order, double alpha) {
-  const StableSplit split = stable_split(sys, alpha);
-  const Eigen::Index nu = split.unstable.states();
-  if (order < nu || order > sys.states())
+BalancedTruncation balanced_truncation_stable_part(const StableSplit& split, Eigen::Index order) {
+  const Eigen::Index nu = split.unstable.states(), n = split.stable.states() + nu;
+  if (order < nu || order > n)
     throw std::invalid_argument("balanced_truncation_stable_part: order must lie between the " + std::to_string(nu) +
-                                " unstable states and the system's " + std::to_string(sys.states()));
+                                " unstable states and the system's " + std::to_string(n));
   BalancedTruncation out = balanced_truncation(split.stable, order - nu);
   out.reduced = parallel(out.reduced, split.unstable);
   out.unstable_states = nu;
   return out;
+}
+
+BalancedTruncation balanced_truncation_stable_part(const StateSpace& sys, Eigen::Index order, double alpha) {
+  return balanced_truncation_stable_part(stable_split(sys, alpha), order);
 }
 
 Eigen::VectorXd hankel_singular_values(const StateSpace& sys) {

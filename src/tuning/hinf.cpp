@@ -196,28 +196,30 @@ core::StateSpace compensator_transfer(HinfDesign& d, std::optional<int> order, b
   const core::StateSpace k = core::series(d.k0, integrator);
   d.full_order = static_cast<int>(k.states());
   if (!order && !minimal) return k;
+  core::StableSplit split;
+  try {
+    split = core::stable_split(k, core::kStableBoundary);
+    if (!order) d.hankel = as_vector(core::hankel_singular_values(split.stable));
+  } catch (const std::domain_error&) {
+    if (order) throw;
+    d.hankel.clear();  // poles too close to the boundary to split: keep K as it is
+    return k;
+  }
   std::optional<int> target = order;
   if (!target) {
     // The minimal realization: W2's poles (the target pair and (s + w0S)^k) cancel in K, which
     // shows as Hankel singular values near rounding level; those states go, nothing else.
-    try {
-      d.hankel = as_vector(core::hankel_singular_values(core::stable_split(k, core::kStableBoundary).stable));
-    } catch (const std::domain_error&) {
-      d.hankel.clear();  // poles too close to the boundary to split: keep K as it is
-      return k;
-    }
     const double floor = kCancellationLevel * (d.hankel.empty() ? 0.0 : d.hankel.front());
     const auto cancelled = std::count_if(d.hankel.begin(), d.hankel.end(), [&](double h) { return h <= floor; });
     if (cancelled == 0) return k;
     target = d.full_order - static_cast<int>(cancelled);
   }
-  const core::StableSplit split = core::stable_split(k, core::kStableBoundary);
   const int kept = static_cast<int>(split.unstable.states());
   if (*target < kept || *target > d.full_order)
     throw core::InputError(core::at_field("controller_order"),
                            "expected between " + std::to_string(kept) + " (the controller's integrator and unstable poles) and " +
                                std::to_string(d.full_order) + " (its full order) states, got " + std::to_string(*target));
-  const core::BalancedTruncation bt = core::balanced_truncation_stable_part(k, *target, core::kStableBoundary);
+  const core::BalancedTruncation bt = core::balanced_truncation_stable_part(split, *target);
   d.hankel = as_vector(bt.hankel);
   d.reduction_error_bound = bt.error_bound;
   return bt.reduced;

@@ -66,5 +66,8 @@ inline constexpr double kStableBoundary = -1.4901161193847656e-08;
 /// above the system's.
 BalancedTruncation balanced_truncation_stable_part(const StateSpace& sys, Eigen::Index order,
                                                    double alpha = kStableBoundary);
+/// The same on a split already made (a caller that also needs the split's parts, e.g. to check
+/// the order against the unstable states first).
+BalancedTruncation balanced_truncation_stable_part(const StableSplit& split, Eigen::Index order);
 
 }  // namespace servotwin::core
