@@ -131,8 +131,10 @@ void print_hinf(const tuning::FullOrderSummary& f, double hz) {
     fmt::print("higher modes: {} (C7.16)\n", h.modes == tuning::ModeHandling::kActive
                                                  ? "designed with, damped actively (V extended, eq. 7.164)"
                                                  : "designed with, cancelled by the controller (passive)");
-  // Below 1e-6 of the largest Hankel value only cancelled states went: the minimal realization.
-  const bool truncated = !h.hankel.empty() && h.reduction_error_bound > 1e-6 * h.hankel.front();
+  // The minimal realization drops only states of Hankel value <= 1e-6 of the largest, so its bound
+  // 2 sum(dropped) stays below 2e-6 * (count) * largest; a larger bound means a truncation.
+  const bool truncated = !h.hankel.empty() && h.reduction_error_bound > 2e-6 * static_cast<double>(h.hankel.size()) *
+                                                                             h.hankel.front();
   fmt::print("controller order: {} of {} ({}); Hankel singular values of its stable part:", f.compensator.states(),
              h.full_order,
              truncated ? fmt::format("balanced truncation, ||K_full - K||inf <= {:.3g}", h.reduction_error_bound)
@@ -163,7 +165,12 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
   fmt::print("  bandwidth: motor {:.4g} Hz, load {}\n", i.bandwidth_motor * hz,
              std::isnan(i.bandwidth_load) ? std::string("n/a (higher modes: no load side)")
                                           : fmt::format("{:.4g} Hz", i.bandwidth_load * hz));
-  fmt::print("  peaks: ||S|| = {:.3g}, ||T|| = {:.3g}, ||wl/w*|| = {:.3g}; J2 = {:.3g}\n", i.peak_s, i.peak_t, i.peak_tl, i.j2);
+  if (std::isnan(i.peak_tl))
+    fmt::print("  peaks: ||S|| = {:.3g}, ||T|| = {:.3g} (no load side)\n", i.peak_s, i.peak_t);
+  else
+    fmt::print("  peaks: ||S|| = {:.3g}, ||T|| = {:.3g}, ||wl/w*|| = {:.3g}; J2 = {:.3g}\n", i.peak_s, i.peak_t, i.peak_tl, i.j2);
+  fmt::print("  least closed-loop damping: {:.3g}{}\n", i.min_damping,
+             c.design.min_damping ? fmt::format(" (required >= {:.3g})", *c.design.min_damping) : std::string());
   fmt::print("  margins: gain {}, phase {}, modulus {:.3g}\n", margin(i.gain_margin_db, "dB"),
              margin(i.phase_margin_deg, "deg"), i.modulus_margin);
   fmt::print("  step: overshoot {:.1f} %, 2 % settling {:.4g} s; load-step ITAE {:.4g} (normalized)\n",

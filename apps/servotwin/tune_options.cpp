@@ -38,6 +38,9 @@ void add_spec_options(CLI::App& cmd, TuneSpecArgs& a) {
   cmd.add_option("--ms", a.ms, "Limit on the sensitivity peak ||S||")->capture_default_str();
   cmd.add_option("--mt", a.mt, "Limit on the tracking peak ||wl/w*|| (motor side without a load side)")
       ->capture_default_str();
+  cmd.add_option("--min-damping", a.min_damping,
+                 "Least damping of the visible closed-loop poles (0..1): also required by the automatic search; "
+                 "for plants with higher modes, where a pole near an antiresonance can leave the load or frame ringing");
   cmd.add_option("--w2-num", a.w2_num, "Uncertainty weight W2(s) numerator, descending powers of s [rad/s], e.g. \"2.6,0\"");
   cmd.add_option("--w2-den", a.w2_den, "Uncertainty weight W2(s) denominator, e.g. \"1,15\"");
   cmd.add_option("--w2-from-frf", a.w2_from_frf,
@@ -54,6 +57,7 @@ void add_spec_options(CLI::App& cmd, TuneSpecArgs& a) {
 void apply_spec(const TuneSpecArgs& a, const TunePlant& plant, tuning::TuneOptions& o) {
   o.ms = a.ms;
   o.mt = a.mt;
+  o.min_damping = a.min_damping;
   if (a.w2_num.empty() != a.w2_den.empty()) {
     throw core::InputError(core::at_field(a.w2_num.empty() ? "--w2-num" : "--w2-den"), "give both --w2-num and --w2-den");
   }

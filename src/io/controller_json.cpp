@@ -434,7 +434,8 @@ void check_derived(const Section& s, const char* derived, const char* base, doub
 }
 
 tuning::DesignParameters read_design(const Section& s, double omega_z, Structure structure) {
-  s.object.allow_only({"omega_star", "omega_star_hz", "zeta_star", "r_target", "ms", "mt", "omega_star_source"});
+  s.object.allow_only(
+      {"omega_star", "omega_star_hz", "zeta_star", "r_target", "ms", "mt", "min_damping", "omega_star_source"});
   tuning::DesignParameters d;
   if (tuning::is_full_order(structure)) {
     // A full-order design assigns no pole pair: ω* and ζ* are null.
@@ -453,6 +454,11 @@ tuning::DesignParameters read_design(const Section& s, double omega_z, Structure
     const std::optional<double> v = s.nullable(key);
     if (v && !(*v >= 1.0)) s.fail(key, "expected a peak limit >= 1 or null, got " + show(*v));
     (std::string(key) == "ms" ? d.ms : d.mt) = v;
+  }
+  if (s.object.has("min_damping")) {  // absent in files written before the option existed
+    d.min_damping = s.nullable("min_damping");
+    if (d.min_damping && !(*d.min_damping > 0.0 && *d.min_damping < 1.0))
+      s.fail("min_damping", "expected a damping ratio in (0, 1) or null, got " + show(*d.min_damping));
   }
   d.omega_star_source = s.object.string("omega_star_source");
   return d;
@@ -795,6 +801,7 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
             {"r_target", optional_finite(d.r_target, "design.r_target")},
             {"ms", optional_finite(d.ms, "design.ms")},
             {"mt", optional_finite(d.mt, "design.mt")},
+            {"min_damping", optional_finite(d.min_damping, "design.min_damping")},
             {"omega_star_source", d.omega_star_source}}},
           {"predicted", predicted_json(c.predicted, wz)},
           {"robustness", robustness_json(c.robustness)},

@@ -10,6 +10,7 @@
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/machine_json.hpp"
 #include "servotwin/io/program_file.hpp"
+#include "servotwin/machine/flexible_frame.hpp"
 #include "servotwin/machine/flexible_presets.hpp"
 
 namespace servotwin::io {
@@ -157,6 +158,34 @@ machine::TransferFunctionModel read_transfer_function(const Source& src) {
   return machine::TransferFunctionModel{core::TransferFunction(n, d)};
 }
 
+// The four-mass frame enters as its rotor-velocity transfer function (eq. 7.172; times 1/s for a
+// position output): the linear design and the simulation need nothing more, and the file keeps
+// the physical parameters a user can read.
+machine::TransferFunctionModel read_flexible_frame(const Source& src, machine::PlantOutput output) {
+  const JsonObject& o = src.o;
+  machine::FlexibleFrame f;
+  f.frame_mass = positive(o, "frame_mass");
+  f.frame_stiffness = positive(o, "frame_stiffness");
+  f.frame_damping = non_negative(o, "frame_damping");
+  f.stator_mass = positive(o, "stator_mass");
+  f.mount_stiffness = positive(o, "mount_stiffness");
+  f.mount_damping = non_negative(o, "mount_damping");
+  f.rotor_mass = positive(o, "rotor_mass");
+  f.coupling_stiffness = positive(o, "coupling_stiffness");
+  f.coupling_damping = non_negative(o, "coupling_damping");
+  f.load_mass = positive(o, "load_mass");
+  const core::TransferFunction velocity = machine::flexible_frame_transfer_function(f);
+  switch (output) {
+    case machine::PlantOutput::MotorVelocity:
+      return machine::TransferFunctionModel{velocity};
+    case machine::PlantOutput::MotorPosition:
+      return machine::TransferFunctionModel{
+          core::TransferFunction(velocity.num(), velocity.den() * core::Polynomial{1.0, 0.0})};
+    default:
+      o.fail("output", "a flexible-frame plant measures the rotor (motor_velocity or motor_position)");
+  }
+}
+
 machine::PlantSettings read_settings(const Source& src) {
   const JsonObject& o = src.o;
   machine::PlantSettings s;
@@ -283,10 +312,15 @@ machine::PlantConfig parse_plant_json(std::string_view text, std::string_view so
   } else if (type == "transfer-function") {
     allow(src, {"num", "den"});
     plant.model = read_transfer_function(src);
+  } else if (type == "flexible-frame") {
+    allow(src, {"frame_mass", "frame_stiffness", "frame_damping", "stator_mass", "mount_stiffness", "mount_damping",
+                 "rotor_mass", "coupling_stiffness", "coupling_damping", "load_mass"});
   } else {
-    root.fail("type", "unknown plant type \"" + type + "\" (expected two-mass, mass-chain or transfer-function)");
+    root.fail("type", "unknown plant type \"" + type +
+                          "\" (expected two-mass, mass-chain, transfer-function or flexible-frame)");
   }
   plant.settings = read_settings(src);
+  if (type == "flexible-frame") plant.model = read_flexible_frame(src, plant.settings.output);
   plant.name = root.string_or("name", std::filesystem::path(std::string(source_name)).stem().string());
   plant.description = root.string_or("description", "");
   try {

@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "servotwin/core/error.hpp"
+#include "servotwin/machine/flexible_frame.hpp"
 
 namespace servotwin::machine {
 
@@ -107,10 +108,20 @@ PlantConfig motor_bench() {
   return c;
 }
 
+PlantConfig c7_19_frame() {
+  const core::TransferFunction p = flexible_frame_transfer_function(c7_19_flexible_frame());
+  return tf_plant("c7.19-frame",
+                  "Flexible-frame four-mass example (dissertation sec. 7.6, eq. 7.175; catalog C7.19/E34): rotor "
+                  "velocity in stator coordinates per motor force, eq. 7.172, m1 = 70, k1 = 4500, b1 = 0.01, m2 = 0.2, "
+                  "k2 = 5, b2 = 0.02, m3 = 0.1, k3 = 0.1, b3 = 0.01, m4 = 0.2 (inferred); modes 1.22, 5.0, 8.03 rad/s; "
+                  "ts 10 ms chosen",
+                  p.num(), p.den(), 0.01, PlantOutput::MotorVelocity);
+}
+
 }  // namespace
 
 std::vector<std::string> flexible_preset_names() {
-  return {"testbed-1", "testbed-2", "gantry-crane", "rfid-demo", "table-5.1", "motor-bench"};
+  return {"testbed-1", "testbed-2", "gantry-crane", "rfid-demo", "table-5.1", "motor-bench", "c7.19-frame"};
 }
 
 PlantConfig flexible_preset(std::string_view name) {
@@ -120,6 +131,7 @@ PlantConfig flexible_preset(std::string_view name) {
   if (name == "rfid-demo") return rfid_demo();
   if (name == "table-5.1") return table_5_1();
   if (name == "motor-bench") return motor_bench();
+  if (name == "c7.19-frame") return c7_19_frame();
   std::string names;
   for (const auto& n : flexible_preset_names()) names += (names.empty() ? "" : ", ") + n;
   throw core::InputError(core::at_field("plant"), "unknown plant preset '" + std::string(name) + "' (known: " + names + ")");

@@ -67,6 +67,11 @@ ExtraDynamics extra_dynamics(const NormalizedPlant& plant, const VelocityHinfWei
   if (weights.modes == ModeHandling::kFirstMode) return e;
   // Each higher mode with unit DC gain, as NormalizedPlant::motor() has it.
   for (const fit::Mode& m : plant.higher_modes) {
+    // A practically unobservable mode stays out of the design model: the motor can neither see nor
+    // drive it, relocating it would cost a controller gain ~1/(wp/wz - 1), and its barely damped,
+    // nearly cancelled pair makes the synthesis' Riccati equations ill-posed (C7.19's frame with a
+    // 5 ms delay finds no controller with it). The tuner still evaluates the loop with it.
+    if (practically_unobservable(m)) continue;
     const double wz = m.antiresonance.omega_rad_s, wp = m.resonance.omega_rad_s;
     e.modes_num = ((wp * wp) / (wz * wz)) * (e.modes_num * quadratic(wz, m.antiresonance.zeta));
     e.modes_den = e.modes_den * quadratic(wp, m.resonance.zeta);
@@ -256,6 +261,10 @@ HinfDesign design(const NormalizedPlant& plant, const VelocityHinfWeights& weigh
 }
 
 }  // namespace
+
+bool practically_unobservable(const fit::Mode& mode) noexcept {
+  return mode.resonance.omega_rad_s < kUnobservableModeRatio * mode.antiresonance.omega_rad_s;
+}
 
 const char* to_string(ModeHandling m) noexcept {
   switch (m) {

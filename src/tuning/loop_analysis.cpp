@@ -8,7 +8,10 @@
 #include <functional>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <span>
+#include <utility>
+#include <vector>
 
 #include "checks.hpp"
 #include "servotwin/core/error.hpp"
@@ -309,13 +312,26 @@ void simulate_steps(std::span<const core::TransferFunction> tfs, double dt, std:
   }
 }
 
-void time_indices(const ClosedLoopTransfer& cl, bool load, const AnalysisOptions& o, LoopIndices& out) {
+// A closed-loop pole within this relative distance of both a zero and a pole of the loop gain L
+// belongs to a nearly cancelled pole-zero pair of L.
+constexpr double kCancellationDistance = 1e-3;
+// Only lightly damped poles are tested for cancellation (a practically unobservable mode); the
+// real poles that set most horizons are not, which keeps the scans' cost unchanged.
+constexpr double kCancellationDampingBelow = 0.1;
+
+bool near_any(const Complex& p, const std::vector<Complex>& roots) {
+  return std::any_of(roots.begin(), roots.end(),
+                     [&](const Complex& z) { return std::abs(p - z) <= kCancellationDistance * std::abs(p); });
+}
+
+double damping_of(const Complex& p) { return std::abs(p) > 0.0 ? -p.real() / std::abs(p) : 1.0; }
+
+void time_indices(const ClosedLoopTransfer& cl, const std::vector<Complex>& visible, bool load,
+                  const AnalysisOptions& o, LoopIndices& out) {
   double fastest = 0.0;
   double slowest = kInf;
-  for (const Complex& p : out.closed_loop_poles) {
-    fastest = std::max(fastest, std::abs(p));
-    slowest = std::min(slowest, -p.real());
-  }
+  for (const Complex& p : out.closed_loop_poles) fastest = std::max(fastest, std::abs(p));
+  for (const Complex& p : visible) slowest = std::min(slowest, -p.real());
   out.horizon = o.horizon_time_constants / slowest;
   out.sample_time = 0.02 / fastest;
   auto samples = static_cast<std::size_t>(std::ceil(out.horizon / out.sample_time)) + 1;
@@ -381,14 +397,51 @@ void validate(const AnalysisOptions& o) {
     throw core::InputError(core::at_field("max_samples"), "expected at least 100 samples, got " + std::to_string(o.max_samples));
 }
 
+/// The zeros and poles of the plant and of the feedback controller, rooted on first use.
+struct BlockRoots {
+  std::vector<Complex> plant_zeros, plant_poles, controller_zeros, controller_poles;
+  explicit BlockRoots(const VelocityLoop& loop)
+      : plant_zeros(loop.plant_num().roots()),
+        plant_poles(loop.plant_den().roots()),
+        controller_zeros(loop.controller_tf().feedback.num().roots()),
+        controller_poles(loop.controller_tf().feedback.den().roots()) {}
+  /// p sits on a nearly cancelled pole-zero pair of the plant or of the controller.
+  [[nodiscard]] bool cancelled(const Complex& p) const {
+    return (near_any(p, plant_zeros) && near_any(p, plant_poles)) ||
+           (near_any(p, controller_zeros) && near_any(p, controller_poles));
+  }
+};
+
+std::vector<Complex> visible_poles(const VelocityLoop& loop, const std::vector<Complex>& poles) {
+  std::vector<Complex> visible;
+  visible.reserve(poles.size());
+  std::optional<BlockRoots> roots;
+  for (const Complex& p : poles) {
+    if (damping_of(p) >= kCancellationDampingBelow) {
+      visible.push_back(p);
+      continue;
+    }
+    if (!roots) roots.emplace(loop);
+    if (!roots->cancelled(p)) visible.push_back(p);
+  }
+  return visible.empty() ? poles : visible;  // every pole cancelled: keep them all
+}
+
+double least_visible_damping(const VelocityLoop& loop, const std::vector<Complex>& poles) {
+  double least = kInf;
+  for (const Complex& p : visible_poles(loop, poles)) least = std::min(least, damping_of(p));
+  return least;
+}
+
 LoopIndices analyse(const VelocityLoop& loop, const AnalysisOptions& options) {
   validate(options);
   LoopIndices out;
   const ClosedLoopTransfer cl = loop.closed_loop();
   out.closed_loop_poles = cl.characteristic.roots();
   out.min_damping = kInf;
-  for (const Complex& p : out.closed_loop_poles)
-    out.min_damping = std::min(out.min_damping, std::abs(p) > 0.0 ? -p.real() / std::abs(p) : 1.0);
+  const std::vector<Complex> visible = visible_poles(loop, out.closed_loop_poles);
+  out.min_damping = kInf;
+  for (const Complex& p : visible) out.min_damping = std::min(out.min_damping, damping_of(p));
   out.closed_loop_stable = loop.stable();
   out.hf_controller_gain =
       options.hf_gain_omega > 0.0 ? std::abs(loop.controller(options.hf_gain_omega)) : loop.controller_hf_limit();
@@ -398,7 +451,7 @@ LoopIndices analyse(const VelocityLoop& loop, const AnalysisOptions& options) {
   }
   const std::vector<double> grid = analysis_grid(options, out.closed_loop_poles);
   frequency_indices(loop, cl, grid, options, out);
-  time_indices(cl, loop.has_load(), options, out);
+  time_indices(cl, visible, loop.has_load(), options, out);
   return out;
 }
 

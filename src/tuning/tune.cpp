@@ -21,6 +21,8 @@ using core::InputError;
 using core::at_field;
 
 constexpr double kRatioForPassiveMethods = 1.3;  // C7.4: below it no PI/PID reaches a useful bandwidth
+// Below this least closed-loop damping a design on a modal model (no load side) gets a note.
+constexpr double kLowDampingNote = 0.1;
 
 void require(bool ok, const char* flag, const std::string& message) {
   if (!ok) throw InputError(at_field(flag), message);
@@ -38,6 +40,9 @@ void validate(const TuneOptions& o) {
   if (o.tau) require(std::isfinite(*o.tau) && *o.tau > 0.0, "--tau", fmt::format("expected a time > 0 s, got {}", *o.tau));
   require(std::isfinite(o.ms) && o.ms > 1.0, "--ms", fmt::format("expected a sensitivity peak limit > 1, got {}", o.ms));
   require(std::isfinite(o.mt) && o.mt >= 1.0, "--mt", fmt::format("expected a tracking peak limit >= 1, got {}", o.mt));
+  if (o.min_damping)
+    require(std::isfinite(*o.min_damping) && *o.min_damping > 0.0 && *o.min_damping < 1.0, "--min-damping",
+            fmt::format("expected a damping ratio in (0, 1), got {}", *o.min_damping));
   if (o.ts) require(std::isfinite(*o.ts) && *o.ts > 0.0, "--ts", fmt::format("expected a sample period > 0 s, got {}", *o.ts));
   require(o.setpoint_weight >= 0.0 && o.setpoint_weight <= 1.0, "--setpoint-weight",
           fmt::format("expected a weight in [0, 1], got {}", o.setpoint_weight));
@@ -144,6 +149,10 @@ struct SpecCheck {
     c.peak_tracking = core::peak_on_grid(tracking, grid, 1e-4).value;
     c.bandwidth = core::bandwidth(tracking, bandwidth_grid).value_or(0.0);
     c.feasible = c.peak_s <= options.ms && c.peak_tracking <= options.mt;
+    if (options.min_damping) {
+      c.min_damping = least_visible_damping(loop, loop.closed_loop().characteristic.roots());
+      c.feasible = c.feasible && c.min_damping >= *options.min_damping;
+    }
     if (c.feasible && w2) c.feasible = robust(loop);
     return c;
   }
@@ -217,6 +226,21 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Eva
                      fmt::format("no {} in the {} gives a stable loop with the known HF dynamics: reduce the "
                                  "delay/lags or use a slower structure",
                                  parameter, lqg ? "range [1e-4, 1e3]" : hinf ? "range [0.05, 2r]" : "admissible range"));
+  }
+  if (o.min_damping) {
+    double best_damping = 0.0, at_damping = 0.0;
+    for (const TuneResult::Candidate& c : scan)
+      if (c.stable && c.peak_s <= o.ms && c.peak_tracking <= o.mt && c.min_damping > best_damping) {
+        best_damping = c.min_damping;
+        at_damping = c.omega_star;
+      }
+    if (best_damping > 0.0)
+      throw InputError(at_field("--min-damping"),
+                       fmt::format("no {} within ||S|| <= {} and the tracking peak <= {} gives every visible "
+                                   "closed-loop pole a damping >= {}: the best is {:.3g} at {} = {:.3g}; lower "
+                                   "--min-damping",
+                                   parameter, o.ms, o.mt, *o.min_damping, best_damping,
+                                   lqg ? "kbw" : hinf ? "w0S/omega_z" : "omega*/omega_z", at_damping));
   }
   throw InputError(at_field(o.w2 ? "--w2" : "--ms"),
                    fmt::format("no {} meets ||S|| <= {} and the tracking peak <= {}{}: the best achievable are "
@@ -523,16 +547,25 @@ struct HinfDesigner {
   [[nodiscard]] VelocityLoop loop(const HinfDesign& d) const { return VelocityLoop(plant, two_dof_form(d.compensator)); }
 };
 
-/// One w0S: the first w0T of the ladder (or the given one) whose design meets the spec; the
-/// candidate of the last w0T tried when none does.
+/// One w0S: the first w0T of the ladder (or the given one) whose design meets the spec; when none
+/// does, the tried one closest to it (closer_to_spec).
 struct HinfCandidate {
   TuneResult::Candidate candidate;
   double omega_0t = 0.0;
 };
 
+/// Of two infeasible candidates, the one closer to the spec: meeting the peak limits first, then
+/// the larger least damping (what --min-damping's error message reports).
+bool closer_to_spec(const TuneResult::Candidate& a, const TuneResult::Candidate& b, const TuneOptions& o) {
+  const auto peaks_ok = [&](const TuneResult::Candidate& c) { return c.stable && c.peak_s <= o.ms && c.peak_tracking <= o.mt; };
+  if (peaks_ok(a) != peaks_ok(b)) return peaks_ok(a);
+  return a.min_damping > b.min_damping;
+}
+
 HinfCandidate evaluate_hinf(const HinfDesigner& h, const SpecCheck& check, double omega_0s) {
   const double r = h.design_plant.r;
   HinfCandidate out;
+  std::optional<HinfCandidate> closest;
   for (int step = 0; step < (h.options.omega_0t ? 1 : kOmega0tSteps); ++step) {
     out.omega_0t = h.options.omega_0t.value_or(r * std::ldexp(1.0, step));
     try {
@@ -545,21 +578,35 @@ HinfCandidate evaluate_hinf(const HinfDesigner& h, const SpecCheck& check, doubl
       out.candidate = {};  // more unstable controller poles than the order asked for
       out.candidate.omega_star = omega_0s;
     }
-    if (out.candidate.feasible) break;
+    if (out.candidate.feasible) return out;
+    if (!closest || closer_to_spec(out.candidate, closest->candidate, h.options)) closest = out;
   }
-  return out;
+  return closest.value_or(out);
 }
 
 /// What the design did with the higher modes (C7.16).
-std::string higher_modes_note(const TuneOptions& o, std::size_t count) {
-  if (o.structure == Structure::kHinf && o.hinf_modes == ModeHandling::kActive)
+std::string higher_modes_note(const TuneOptions& o, const std::vector<fit::Mode>& modes) {
+  const std::size_t count = modes.size();
+  const bool hinf = o.structure == Structure::kHinf;
+  std::string unobservable;
+  for (std::size_t i = 0; i < count; ++i)
+    if (practically_unobservable(modes[i]))
+      unobservable += fmt::format("{}mode {} ({:.4g}/{:.4g} omega_z)", unobservable.empty() ? "" : ", ", i + 2,
+                                  modes[i].resonance.omega_rad_s, modes[i].antiresonance.omega_rad_s);
+  const std::string except =
+      unobservable.empty()
+          ? std::string()
+          : "; except " + unobservable +
+                ": resonance within 1 % of its antiresonance, practically unobservable from the motor, left out of "
+                "the design (damping it needs another sensor, e.g. a frame accelerometer)";
+  if (hinf && o.hinf_modes == ModeHandling::kActive)
     return fmt::format("designed on the full model: the {} higher mode(s) are damped actively (C7.16, V extended "
-                       "as eq. 7.164), at a larger controller gain at their frequencies",
-                       count);
-  if (o.structure == Structure::kHinf && o.hinf_modes == ModeHandling::kPassive)
+                       "as eq. 7.164), at a larger controller gain at their frequencies{}",
+                       count, except);
+  if (hinf && o.hinf_modes == ModeHandling::kPassive)
     return fmt::format("designed on the full model: the controller cancels the {} higher mode(s) (a notch; "
-                       "C7.16 passive): disturbances at the motor still excite them",
-                       count);
+                       "C7.16 passive): disturbances at the motor still excite them{}",
+                       count, except);
   return fmt::format("designed on the first mode; {} higher mode(s) are included in every index", count);
 }
 
@@ -711,6 +758,7 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   c.plant = scales(plant);
   c.design.ms = options.ms;
   c.design.mt = options.mt;
+  c.design.min_damping = options.min_damping;
   if (options.structure == Structure::kHinf) {
     tune_hinf(result, options, check);
   } else if (is_full_order(options.structure)) {
@@ -718,7 +766,13 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   } else {
     tune_cascade(result, options, check);
   }
-  if (!plant.higher_modes.empty()) c.notes.push_back(higher_modes_note(options, plant.higher_modes.size()));
+  if (!plant.higher_modes.empty()) c.notes.push_back(higher_modes_note(options, plant.higher_modes));
+  if (!plant.higher_modes.empty() && !options.min_damping && c.predicted.min_damping < kLowDampingNote)
+    c.notes.push_back(fmt::format(
+        "least closed-loop damping {:.3g}: without a load side the search maximizes the motor bandwidth and may "
+        "leave a closed-loop mode (near an antiresonance or a higher resonance) ringing in the load or the frame "
+        "while the motor is quiet; --min-damping 0.15 trades bandwidth for damping",
+        c.predicted.min_damping));
   if (options.ts) add_discrete(c, *options.ts);
   return result;
 }

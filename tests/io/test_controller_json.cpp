@@ -109,6 +109,7 @@ Controller make_controller(Structure structure, bool discrete, bool infinite_mar
   c.design.zeta_star = 0.8;
   if (structure == Structure::kPid) c.design.r_target = 2.0;
   c.design.ms = 1.5;
+  if (structure == Structure::kPi) c.design.min_damping = 0.15;
   c.design.omega_star_source = "J1 (load bandwidth)";
   c.predicted = indices(infinite_margins);
   c.robustness.rs = 0.62;
@@ -164,6 +165,7 @@ void expect_round_trip(const Controller& c, const Controller& b) {
   EXPECT_EQ(b.design.r_target, c.design.r_target);
   EXPECT_EQ(b.design.ms, c.design.ms);
   EXPECT_EQ(b.design.mt, c.design.mt);
+  EXPECT_EQ(b.design.min_damping, c.design.min_damping);
   EXPECT_EQ(b.design.omega_star_source, c.design.omega_star_source);
   const tuning::LoopIndices &p = b.predicted, &q = c.predicted;
   EXPECT_EQ(p.closed_loop_stable, q.closed_loop_stable);
@@ -723,6 +725,7 @@ TEST_F(ControllerJsonErrors, PlantDesignAndDerivedMembers) {
   expect(with([](auto& c) { c["design"]["omega_star_hz"] = 30.0; }), "design.omega_star_hz", "omega_star");
   expect(with([](auto& c) { c["design"]["zeta_star"] = 0.0; }), "design.zeta_star", "> 0");
   expect(with([](auto& c) { c["design"]["ms"] = 0.8; }), "design.ms", ">= 1");
+  expect(with([](auto& c) { c["design"]["min_damping"] = 1.0; }), "design.min_damping", "(0, 1)");
   expect(with([](auto& c) { c["design"]["r_target"] = 1.0; }), "design.r_target", "> 1");
   expect(with([](auto& c) { c["predicted"]["bandwidth_motor_hz"] = 44.1; }), "predicted.bandwidth_motor_hz",
          "bandwidth_motor");

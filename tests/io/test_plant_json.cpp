@@ -96,6 +96,44 @@ TEST(PlantJson, MassChainAndTransferFunctionParse) {
   EXPECT_EQ(model.tf.num().coefficients()[1], 0.06);
 }
 
+// The flexible-frame type is read as eq. 7.172 (machine::flexible_frame_transfer_function): the
+// C7.19 document gives the preset's model.
+const char* kFrame = R"({"format": "servotwin.plant/1", "type": "flexible-frame",
+  "frame_mass": 70, "frame_stiffness": 4500, "frame_damping": 0.01, "stator_mass": 0.2,
+  "mount_stiffness": 5, "mount_damping": 0.02, "rotor_mass": 0.1, "coupling_stiffness": 0.1,
+  "coupling_damping": 0.01, "load_mass": 0.2, "noise_std": 0, "ts": 0.01})";
+
+std::string frame_with(const std::string& from, const std::string& to) {
+  std::string text = kFrame;
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return text.replace(pos, from.size(), to);
+}
+
+TEST(PlantJson, FlexibleFrameIsReadAsItsRotorVelocityTransferFunction) {
+  const machine::PlantConfig frame = parse_plant_json(kFrame, "frame.json");
+  const auto& model = std::get<machine::TransferFunctionModel>(frame.model);
+  const machine::PlantConfig preset_config = machine::flexible_preset("c7.19-frame");
+  const auto& preset = std::get<machine::TransferFunctionModel>(preset_config.model);
+  EXPECT_EQ(model.tf.num(), preset.tf.num());
+  EXPECT_EQ(model.tf.den(), preset.tf.den());
+  EXPECT_EQ(model.tf.den().degree(), 7);
+  // A position output adds the integrator.
+  const machine::PlantConfig position =
+      parse_plant_json(frame_with(R"("ts": 0.01)", R"("ts": 0.01, "output": "motor_position")"), "frame.json");
+  const auto& tf = std::get<machine::TransferFunctionModel>(position.model).tf;
+  EXPECT_EQ(tf.den().degree(), 8);
+  EXPECT_EQ(tf.den().coefficients().back(), 0.0);
+}
+
+TEST(PlantJson, BadFlexibleFrameNamesTheField) {
+  EXPECT_EQ(error_field(frame_with(R"("load_mass": 0.2)", R"("load_mass": 0)")), "load_mass");
+  EXPECT_EQ(error_field(frame_with(R"("mount_damping": 0.02)", R"("mount_damping": -1)")), "mount_damping");
+  EXPECT_EQ(error_field(frame_with(R"("frame_mass": 70,)", "")), "frame_mass");
+  EXPECT_EQ(error_field(frame_with(R"("ts": 0.01)", R"("ts": 0.01, "output": "load_velocity")")), "output");
+  EXPECT_EQ(error_field(frame_with(R"("ts": 0.01)", R"("ts": 0.01, "inertias": [1])")), "inertias");
+}
+
 TEST(PlantJson, EveryPresetRoundTrips) {
   for (const auto& name : machine::flexible_preset_names()) {
     const auto preset = machine::flexible_preset(name);

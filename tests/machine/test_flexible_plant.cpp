@@ -360,7 +360,7 @@ TEST(FlexiblePresets, UnknownNameListsKnownOnes) {
   } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("motor-bench"), std::string::npos);
   }
-  EXPECT_EQ(flexible_preset_names().size(), 6U);
+  EXPECT_EQ(flexible_preset_names().size(), 7U);
   for (const auto& name : flexible_preset_names()) EXPECT_EQ(flexible_preset(name).name, name);
 }
 

@@ -8,8 +8,10 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <string>
 
 #include "fixture.hpp"
+#include "servotwin/core/state_space.hpp"
 #include "servotwin/core/transfer_function.hpp"
 #include "servotwin/tuning/hinf.hpp"
 #include "servotwin/tuning/lqg.hpp"
@@ -187,6 +189,72 @@ TEST(TuneHinf, TwoModePlantActivePassiveAndFirstModeDesigns) {
   EXPECT_EQ(active.full_order->compensator.states(), 7);
   EXPECT_EQ(active.full_order->hinf->full_order, 11);
   EXPECT_EQ(passive.full_order->compensator.states(), 7);
+}
+
+/// C7.19's flexible frame (eq. 7.172 with eq. 7.175's parameters and m4 = 0.2, expanded: the
+/// coefficients are exact decimals of those products; machine::flexible_frame_transfer_function
+/// computes the same): an integrator and three modes, the third practically unobservable.
+fit::PlantModel frame_model() {
+  const core::Polynomial num{4.2, 0.6318, 343.81419, 44.176502, 4761.15052, 234.005, 2250.0};
+  const core::Polynomial den{0.28, 0.07012, 25.444222, 5.5961806, 487.800156, 70.2015, 675.0, 0.0};
+  return fit::plant_model_from_transfer_function(core::TransferFunction(num, den));
+}
+
+TEST(TuneHinf, MinimumDampingTradesBandwidthForDamping) {
+  // The frame's active design searched for the largest motor bandwidth leaves a pole near the
+  // frame's antiresonance at damping ~0.06 (and a note says so); with a floor of 0.15 the search
+  // keeps every visible closed-loop pole at it (checked on the poles of analyse(), the third
+  // mode's nearly cancelled pair excepted) at a smaller bandwidth; an unreachable floor names the
+  // option and the best found.
+  const Controller free = tune(frame_model(), hinf_options()).controller;
+  EXPECT_LT(free.predicted.min_damping, 0.1);
+  EXPECT_TRUE(std::any_of(free.notes.begin(), free.notes.end(),
+                          [](const std::string& n) { return n.find("--min-damping") != std::string::npos; }));
+  TuneOptions o = hinf_options();
+  o.min_damping = 0.15;
+  const Controller floored = tune(frame_model(), o).controller;
+  ASSERT_TRUE(floored.design.min_damping.has_value());
+  EXPECT_GE(floored.predicted.min_damping, 0.15);
+  const double third = frame_model().modes[2].resonance.omega_rad_s / floored.plant.omega_z;
+  for (const auto& p : floored.predicted.closed_loop_poles) {
+    if (std::abs(std::abs(p) - third) > 1e-2 * third) {
+      EXPECT_GE(-p.real() / std::abs(p), 0.15 * (1.0 - 1e-9)) << p;
+    }
+  }
+  EXPECT_LT(floored.predicted.bandwidth_motor, free.predicted.bandwidth_motor);
+  EXPECT_TRUE(std::none_of(floored.notes.begin(), floored.notes.end(),
+                           [](const std::string& n) { return n.find("--min-damping") != std::string::npos; }));
+  o.min_damping = 0.95;
+  test::expect_input_error([&] { (void)tune(frame_model(), o); }, "--min-damping", "the best is");
+  o.min_damping = 1.0;
+  test::expect_input_error([&] { (void)tune(frame_model(), o); }, "--min-damping", "(0, 1)");
+}
+
+TEST(TuneHinf, APracticallyUnobservableModeIsLeftOutOfTheDesign) {
+  // C7.19's third mode in miniature: a higher mode whose resonance is 0.02 % above its
+  // antiresonance (and barely damped) is left out: the controller is the one designed without the
+  // mode (same order, same response), the note says so, and the analysis on the full model leaves
+  // the mode's closed-loop pole out of the damping and the horizon (a run of hours otherwise).
+  fit::PlantModel with = model(3.0, 0.02);
+  const double wz = with.modes[0].antiresonance.omega_rad_s;
+  with.modes.push_back({{5.0 * wz, 1e-4}, {5.001 * wz, 1e-4}});
+  TuneOptions o = hinf_options();
+  o.omega_0s = 0.8;
+  o.omega_0t = 6.0;
+  const Controller c = tune(with, o).controller;
+  const Controller without = tune(model(3.0, 0.02), o).controller;
+  EXPECT_EQ(c.full_order->compensator.states(), without.full_order->compensator.states());
+  for (double w : {0.3, 1.0, 3.0, 10.0}) {
+    const auto a = core::frequency_response(c.full_order->compensator, w, 0, 1);
+    const auto b = core::frequency_response(without.full_order->compensator, w, 0, 1);
+    EXPECT_LT(std::abs(a - b), 1e-6 * std::abs(b)) << w;
+  }
+  EXPECT_TRUE(std::any_of(c.notes.begin(), c.notes.end(),
+                          [](const std::string& n) { return n.find("practically unobservable") != std::string::npos; }));
+  EXPECT_GT(c.predicted.min_damping, 0.05);  // the mode's ~1e-4 is not the least visible damping
+  EXPECT_LT(c.predicted.horizon, 10.0 * without.predicted.horizon);
+  EXPECT_TRUE(practically_unobservable(with.modes[1]));
+  EXPECT_FALSE(practically_unobservable(two_mode_model().modes[1]));
 }
 
 TEST(TuneHinf, ControllerOrderIsKeptThroughTheSearchOrRefused) {

@@ -33,6 +33,9 @@
 ///    loop 0.2 ms (C3.2: rise time hundreds of us); ts = 125 us (8 kHz); output motor velocity
 ///    with noise std 0.01 rad/s and the velocity step of a 20-bit encoder differenced at 8 kHz,
 ///    2 pi / 2^20 * 8000 = 0.04794 rad/s.
+///  * c7.19-frame (C7.19, eq. 7.175, E34): the flexible-frame four-mass example as its rotor
+///    velocity per motor force (flexible_frame.hpp, eq. 7.172), with the inferred m4 = 0.2;
+///    ts = 10 ms (chosen; not printed).
 
 #include <string>
 #include <string_view>

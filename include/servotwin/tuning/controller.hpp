@@ -54,6 +54,7 @@ struct DesignParameters {
   double zeta_star = 0.0;             ///< assigned pair's damping (0: full-order, none)
   std::optional<double> r_target;     ///< PID: virtual resonance ratio r̄
   std::optional<double> ms, mt;       ///< peak limits the design respected
+  std::optional<double> min_damping;  ///< least visible closed-loop damping the design respected (TuneOptions::min_damping)
   std::string omega_star_source;      ///< "given", "J1 (load bandwidth)", "limited by ‖S‖ <= Ms", ...
 };
 

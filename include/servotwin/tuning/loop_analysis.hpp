@@ -21,7 +21,8 @@
 /// between samples, so the samples are exact) of all step responses, which share the
 /// characteristic polynomial Δ. Step dt = 0.02/max|p| over the closed-loop poles p (50 samples
 /// per time constant of the fastest pole), horizon = horizon_time_constants/min(−Re p) (15 time
-/// constants of the slowest pole: its residue decays to e^{−15} ≈ 3e-7); when that needs more than
+/// constants of the slowest pole: its residue decays to e^{−15} ≈ 3e-7) over visible_poles (a
+/// nearly cancelled mode would ask for a run of hours and shows in no response); when that needs more than
 /// max_samples samples, dt = horizon/max_samples instead (still exact at the samples; only the
 /// resolution of the overshoot, the settling-time interpolation and the ITAE quadrature drops).
 
@@ -94,11 +95,23 @@ struct LoopIndices {
   double itae_load_step = 0.0;          ///< ∫ t |ωl(t)| dt for a unit load-torque step (trapezoidal)
   double peak_torque_step = 0.0;        ///< max |u| for a unit setpoint step
   double hf_controller_gain = 0.0;      ///< |C(jω)| at AnalysisOptions::hf_gain_omega (noise amplification)
-  double min_damping = 0.0;             ///< min −Re p/|p| over the closed-loop poles
+  double min_damping = 0.0;             ///< min −Re p/|p| over the visible closed-loop poles (visible_poles)
   double sample_time = 0.0;             ///< simulation step used (normalized time)
   double horizon = 0.0;                 ///< simulation horizon used
   std::vector<std::complex<double>> closed_loop_poles;  ///< roots of Δ (Padé delay included)
 };
+
+/// The closed-loop poles a response can show: all but a lightly damped pole (ζ < 0.1) within
+/// 1e-3·|p| of both a zero and a pole of the plant Pm, or of both of the feedback controller. Such
+/// a pole belongs to a nearly cancelled pole-zero pair of one block, a mode the loop neither drives
+/// nor sees (the third mode of C7.19's flexible frame: pole and zero 0.02 % apart), and its residue
+/// in each of the four closed-loop functions (T, S, PS, CS) is of the size of that distance. A
+/// plant pole cancelled by a controller zero (a notch, C7.16 passive) stays visible: the
+/// disturbance response PS keeps it. All poles when every one is cancelled.
+[[nodiscard]] std::vector<std::complex<double>> visible_poles(const VelocityLoop& loop,
+                                                              const std::vector<std::complex<double>>& poles);
+/// min −Re p/|p| over visible_poles (+inf for none).
+[[nodiscard]] double least_visible_damping(const VelocityLoop& loop, const std::vector<std::complex<double>>& poles);
 
 /// All indices of the loop. InputError for invalid options (validate()). The grid pass keeps its
 /// sample buffers in a thread_local workspace (reused between calls; ~150 kB for 2000 points).

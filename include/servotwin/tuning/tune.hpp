@@ -49,6 +49,11 @@ struct TuneOptions {
   bool allow_negative_kd = false;       ///< PID with r < r̄ (acceleration feedback)
   double ms = 1.5;                      ///< ‖S‖∞ limit
   double mt = 1.5;                      ///< tracking peak limit
+  /// Least damping of the visible closed-loop poles (loop_analysis.hpp visible_poles), in (0, 1):
+  /// automatic ω*/kbw/w0S also requires it. For a plant without a load side (higher modes) the
+  /// tracking peak is the motor's, and the loop may leave a pole near an antiresonance barely
+  /// damped (the load or the frame rings while the motor stands still): this asks for damping.
+  std::optional<double> min_damping;
   /// Multiplicative uncertainty weight W2(s) in physical s [rad/s]: when given, automatic ω* also
   /// requires robust performance sup(|S|/Ms + |W2 T|) < 1 and the result reports RS/NP/RP.
   std::optional<core::TransferFunction> w2;
@@ -92,6 +97,7 @@ struct TuneResult {
   /// omega_star, load bandwidth, ‖S‖∞, tracking peak, feasible).
   struct Candidate {
     double omega_star = 0.0, bandwidth = 0.0, peak_s = 0.0, peak_tracking = 0.0;
+    double min_damping = 0.0;  ///< least visible closed-loop damping (evaluated only with TuneOptions::min_damping)
     bool stable = false, feasible = false;
   };
   std::vector<Candidate> scan;

@@ -88,6 +88,9 @@ class VelocityLoop {
                bool with_higher_modes = true, int pade_order = 6);
 
   [[nodiscard]] const ControllerTf& controller_tf() const noexcept { return controller_; }
+  /// Pm = plant_num/plant_den (without the HF dynamics; higher modes as constructed).
+  [[nodiscard]] const core::Polynomial& plant_num() const noexcept { return plant_num_; }
+  [[nodiscard]] const core::Polynomial& plant_den() const noexcept { return plant_den_; }
   /// |C(j∞)|: the controller's high-frequency gain (the ratio of leading coefficients).
   [[nodiscard]] double controller_hf_limit() const noexcept;
   [[nodiscard]] bool has_load() const noexcept { return has_load_; }
