@@ -163,7 +163,9 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
   const tuning::LoopIndices& i = c.predicted;
   fmt::print("predicted (with the known HF dynamics): {}\n", i.closed_loop_stable ? "stable" : "UNSTABLE");
   fmt::print("  bandwidth: motor {:.4g} Hz, load {}\n", i.bandwidth_motor * hz,
-             std::isnan(i.bandwidth_load) ? std::string("n/a (higher modes: no load side)")
+             std::isnan(i.bandwidth_load) ? std::string(p.higher_modes.empty()
+                                                            ? "n/a (no two-mass realization with friction >= 0: no load side)"
+                                                            : "n/a (higher modes: no load side)")
                                           : fmt::format("{:.4g} Hz", i.bandwidth_load * hz));
   if (std::isnan(i.peak_tl))
     fmt::print("  peaks: ||S|| = {:.3g}, ||T|| = {:.3g} (no load side)\n", i.peak_s, i.peak_t);

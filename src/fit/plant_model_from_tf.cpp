@@ -52,10 +52,10 @@ ModalPair modal(Complex root, const std::string& field, const char* what) {
 PlantModel plant_model_from_transfer_function(const core::TransferFunction& velocity_tf, const std::string& field) {
   const core::TransferFunction tf = velocity_tf.normalized();
   const int rel_degree = tf.den().degree() - tf.num().degree();
-  if (rel_degree != 1) {
+  if (rel_degree != 1 && rel_degree != 2) {
     throw core::InputError(core::at_field(field),
                            fmt::format("expected a motor velocity per torque with relative degree 1 (K/s at high frequency), "
-                                       "got {}; for a position output divide by s first",
+                                       "or 2 with a first-order lag, got {}; for a position output divide by s first",
                                        rel_degree));
   }
   const SplitRoots poles = split(tf.den().roots());
@@ -65,9 +65,14 @@ PlantModel plant_model_from_transfer_function(const core::TransferFunction& velo
                                                               "(non-collocated output or extra dynamics)",
                                                               zeros.real.front()));
   }
-  if (poles.real.size() != 1) {
-    throw core::InputError(core::at_field(field),
-                           fmt::format("expected exactly one real pole (the rigid-body mode), found {}", poles.real.size()));
+  const std::size_t real_poles = static_cast<std::size_t>(rel_degree);  // the rigid mode, and the lag
+  if (poles.real.size() != real_poles) {
+    throw core::InputError(
+        core::at_field(field),
+        rel_degree == 1
+            ? fmt::format("expected exactly one real pole (the rigid-body mode), found {}", poles.real.size())
+            : fmt::format("relative degree 2 needs exactly two real poles (the rigid-body mode and the lag), found {}",
+                          poles.real.size()));
   }
   if (poles.pairs.size() != zeros.pairs.size()) {
     throw core::InputError(core::at_field(field), fmt::format("{} resonance pair(s) but {} antiresonance pair(s)",
@@ -75,7 +80,13 @@ PlantModel plant_model_from_transfer_function(const core::TransferFunction& velo
   }
   PlantModel m;
   m.gain = tf.num().leading() / tf.den().leading();
-  const double a = -poles.real.front();
+  // The slower real pole is the rigid-body mode, the faster one the lag 1/(s + tau2) (catalog A6).
+  const double a = -*std::max_element(poles.real.begin(), poles.real.end());
+  if (rel_degree == 2) {
+    const double lag = -*std::min_element(poles.real.begin(), poles.real.end());
+    if (!(lag > 0.0)) throw core::InputError(core::at_field(field), fmt::format("unstable lag pole at {:.6g}", -lag));
+    m.lag_pole_rad_s = lag;
+  }
   double scale = 1.0;
   for (const Complex& p : poles.pairs) scale = std::max(scale, std::abs(p));
   if (a < -1e-12 * scale) {

@@ -29,20 +29,20 @@ PlantConfig tf_plant(std::string name, std::string description, Polynomial num, 
 PlantConfig testbed_1() {
   const double k = 544.6, tau1 = 0.16, tau2 = 0.0038;
   const Polynomial num = k * (quadratic(35.3, 0.19) * quadratic(114.6, 0.11));
-  const Polynomial den = Polynomial{1.0, tau1} * quadratic(70.8, 0.02) * quadratic(260.1, 0.005) * Polynomial{1.0, tau2};
+  const Polynomial den = Polynomial{1.0, tau1} * quadratic(70.8, 0.02) * quadratic(260.1, 0.005) * Polynomial{tau2, 1.0};
   return tf_plant("testbed-1",
                   "Dynamic test bed, configuration 1 (dissertation sec. 8.6, eq. 8.13; catalog E37): motor torque to "
-                  "motor velocity, two resonances 70.8 and 260.1 rad/s; EtherCAT 2 kHz",
+                  "motor velocity, two resonances 70.8 and 260.1 rad/s, lag 1/(0.0038 s + 1); EtherCAT 2 kHz",
                   num, den, 0.0005, PlantOutput::MotorVelocity);
 }
 
 PlantConfig testbed_2() {
   const double k = 454.5, tau1 = 0.15, tau2 = 0.0022;
   const Polynomial num = k * quadratic(49.9, 0.24);
-  const Polynomial den = Polynomial{1.0, tau1} * quadratic(254.0, 0.02) * Polynomial{1.0, tau2};
+  const Polynomial den = Polynomial{1.0, tau1} * quadratic(254.0, 0.02) * Polynomial{tau2, 1.0};
   return tf_plant("testbed-2",
                   "Dynamic test bed, configuration 2 (dissertation sec. 8.6, eq. 8.14; catalog E37): motor torque to "
-                  "motor velocity, resonance 254 rad/s, r = 5.09; EtherCAT 2 kHz",
+                  "motor velocity, resonance 254 rad/s, r = 5.09, lag 1/(0.0022 s + 1); EtherCAT 2 kHz",
                   num, den, 0.0005, PlantOutput::MotorVelocity);
 }
 

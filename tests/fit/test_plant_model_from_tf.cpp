@@ -40,6 +40,19 @@ TEST(PlantModelFromTransferFunction, RoundTripsModels) {
   }
 }
 
+TEST(PlantModelFromTransferFunction, RoundTripsTheTestBedsLag) {
+  // Catalog A6: K/(s + tau1) (modes) 1/(s + tau2); the faster real pole is the lag.
+  PlantModel m = two_mode_model(RigidKind::kRealPole);
+  m.lag_pole_rad_s = 263.2;
+  const PlantModel back = plant_model_from_transfer_function(m.transfer_function());
+  expect_same(back, m);
+  ASSERT_TRUE(back.lag_pole_rad_s.has_value());
+  EXPECT_NEAR(*back.lag_pole_rad_s, 263.2, 1e-9 * 263.2);
+  m.rigid = RigidKind::kIntegrator;
+  m.rigid_pole_rad_s = 0.0;
+  EXPECT_NEAR(*plant_model_from_transfer_function(m.transfer_function()).lag_pole_rad_s, 263.2, 1e-9 * 263.2);
+}
+
 TEST(PlantModelFromTransferFunction, UndampedTwoMassMatchesTheClosedForms) {
   // ωm/Tm = (Il s² + k)/(s (Im Il s² + k (Im + Il))) for Im = 2, Il = 6, k = 1200, b = 0.
   const double im = 2.0, il = 6.0, k = 1200.0;
@@ -63,7 +76,11 @@ TEST(PlantModelFromTransferFunction, RefusesOtherStructuresNamingTheRoot) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message({core::Polynomial{1.0}, core::Polynomial{1.0, 1.0, 0.0}}).find("relative degree"), std::string::npos);
+  EXPECT_NE(message({core::Polynomial{1.0}, core::Polynomial{1.0, 1.0, 1.0, 0.0}}).find("relative degree"), std::string::npos);
+  // Relative degree 2 needs the rigid pole and the lag: (s^2 + 4)/((s^2 + s + 1)(s^2 + 0.4 s + 9))
+  // has neither.
+  EXPECT_NE(message({core::Polynomial{1.0, 0.0, 4.0}, core::Polynomial{1.0, 1.4, 10.4, 9.4, 9.0}}).find("two real poles"),
+            std::string::npos);
   EXPECT_NE(message({core::Polynomial{1.0, 4.0, 3.0}, core::Polynomial{1.0, 2.0, 5.0, 0.0}}).find("real zero at -"), std::string::npos);
   EXPECT_NE(message({core::Polynomial{1.0, 0.0, 4.0}, core::Polynomial{1.0, -1.0, 9.0, 0.0}}).find("unstable pole pair"),
             std::string::npos);

@@ -150,12 +150,13 @@ def tf_case(name, sections, ts, samples, seed, lag=0.0):
 
 def presets():
     out = {}
-    # E37 configuration 1 and 2 (tau as pole locations, catalog defect 29).
+    # E37 configuration 1 and 2: tau1 a pole location (catalog defect 29), tau2 the time constant
+    # of the lag 1/(tau2 s + 1) (flexible_presets.hpp says why).
     num = 544.6 * np.polymul(quad(35.3, 0.19), quad(114.6, 0.11))
-    den = np.polymul(np.polymul(np.polymul([1, 0.16], quad(70.8, 0.02)), quad(260.1, 0.005)), [1, 0.0038])
+    den = np.polymul(np.polymul(np.polymul([1, 0.16], quad(70.8, 0.02)), quad(260.1, 0.005)), [0.0038, 1])
     out["testbed-1"] = dict(num=num.tolist(), den=den.tolist())
     num = 454.5 * quad(49.9, 0.24)
-    den = np.polymul(np.polymul([1, 0.15], quad(254.0, 0.02)), [1, 0.0022])
+    den = np.polymul(np.polymul([1, 0.15], quad(254.0, 0.02)), [0.0022, 1])
     out["testbed-2"] = dict(num=num.tolist(), den=den.tolist())
     num = np.polymul([1, 0.06339, 0.06057], [1, 0.1129, 2.064])
     den = np.polymul(np.polymul([1, 0.04544], [1, 0.04541, 0.9985]), [1, 0.9854, 9.12])
@@ -243,7 +244,7 @@ def main():
                                            ([1, 0.1129, 2.064], [1, 0.9854, 9.12])],
                              0.1, 300, 14),
         tf_testbed2_lag=tf_case("testbed-2+lag", [([454.5], [1, 0.15]), (quad(49.9, 0.24), quad(254.0, 0.02)),
-                                                  ([1.0], [1, 0.0022])], 0.0005, 400, 15, lag=1e-3),
+                                                  ([1.0], [0.0022, 1])], 0.0005, 400, 15, lag=1e-3),
         presets=presets(),
         backlash_sine=backlash_case(),
         coulomb_slide=coulomb_case(),

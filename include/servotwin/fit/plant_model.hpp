@@ -63,10 +63,12 @@ struct PlantModel {
 };
 
 /// The plant model of a velocity transfer function K·Π(s² + 2ζzi ωzi s + ωzi²)/((s + a)·Π(s² + 2ζi ωi s + ωi²))
-/// (or with s for s + a): how a user-given or simulated plant (a mass chain's motor velocity per
-/// torque) enters the tools that take fitted models. Zeros and poles are paired by increasing
-/// frequency (collocated order). Throws core::InputError (field `field`) when the function does
-/// not have that structure: relative degree other than 1, no or several real poles, a real zero,
+/// (or with s for s + a), optionally times a lag 1/(s + τ2) (relative degree 2: the faster of the
+/// two real poles is the lag): how a user-given or simulated plant (a mass chain's motor velocity
+/// per torque, the test bed of A6) enters the tools that take fitted models. Zeros and poles are
+/// paired by increasing frequency (collocated order). Throws core::InputError (field `field`) when
+/// the function does not have that structure: relative degree other than 1 or 2, a real-pole count
+/// other than the relative degree, a real zero,
 /// an unstable pole or zero, or a pole pair without a zero pair; the message names the root.
 [[nodiscard]] PlantModel plant_model_from_transfer_function(const core::TransferFunction& velocity_tf,
                                                             const std::string& field = "plant");
