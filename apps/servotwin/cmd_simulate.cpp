@@ -1,9 +1,12 @@
 // `servotwin simulate`: a tuned controller (servotwin.controller/1) closed around a simulated
 // flexible plant with its nonlinearities, a setpoint or load-torque step, beside the same loop on the
-// plant's linear part; writes the samples as CSV and the comparison as a report.
+// plant's linear part; writes the samples as CSV and the comparison as a report. On a flexible-frame
+// plant, --test frame-sequence runs C7.19's setpoint / load-force / stator-force test instead.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -12,9 +15,12 @@
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/controller_json.hpp"
 #include "servotwin/io/drive_simulation_csv.hpp"
+#include "servotwin/io/frame_sequence_csv.hpp"
 #include "servotwin/io/plant_json.hpp"
+#include "servotwin/io/shaper_json.hpp"
 #include "servotwin/report/drive_report.hpp"
 #include "servotwin/vcnc/drive_simulation.hpp"
+#include "servotwin/vcnc/frame_sequence.hpp"
 
 namespace servotwin::cli {
 
@@ -30,6 +36,8 @@ struct SimulateArgs {
   double band = 0.02;
   std::string out;
   std::string report;
+  double load_force = 0.1, stator_force = 0.1;  // frame-sequence only
+  std::string shaper;                          // frame-sequence only
 };
 
 /// The plant to run: --plant, else the plant description the controller was tuned from.
@@ -98,11 +106,108 @@ void print_summary(const vcnc::DriveSimulation& sim, const std::string& plant_so
   for (const std::string& n : sim.notes) fmt::print("note: {}\n", n);
 }
 
+// ---- the flexible-frame test (C7.19) ----
+
+vcnc::FrameSequenceSettings frame_settings(const SimulateArgs& a, double ts) {
+  vcnc::FrameSequenceSettings s;
+  s.ts = ts;
+  s.setpoint = a.amplitude;
+  s.load_force = a.load_force;
+  s.stator_force = a.stator_force;
+  if (a.duration > 0.0) {  // the dissertation's thirds: 15, 30, 45 s by default
+    s.duration = a.duration;
+    s.load_step_time = a.duration / 3.0;
+    s.stator_step_time = 2.0 * a.duration / 3.0;
+    s.residual_window = std::min(s.residual_window, s.load_step_time / 3.0);
+  }
+  if (!a.shaper.empty()) {
+    const io::LoadedShaper loaded = io::load_shaper(a.shaper);
+    s.shaper_times = loaded.shaper.times;
+    s.shaper_amplitudes = loaded.shaper.amplitudes;
+  }
+  return s;
+}
+
+/// simulate_frame_sequence with its errors named by the options.
+vcnc::FrameSequence run_frame(const machine::FlexibleFrame& frame, const tuning::Controller& controller,
+                              const vcnc::FrameSequenceSettings& s) {
+  try {
+    return vcnc::simulate_frame_sequence(frame, tuning::controller_state_space(controller), s);
+  } catch (const core::InputError& e) {
+    const std::string& field = e.where().field;
+    for (const auto& [name, option] :
+         {std::pair{"setpoint", "--amplitude"}, std::pair{"load_force", "--load-force"},
+          std::pair{"stator_force", "--stator-force"}, std::pair{"duration", "--duration"},
+          std::pair{"residual_window", "--duration"}, std::pair{"controller", "--controller"}})
+      if (field == name) throw core::InputError(core::at_field(option), e.reason());
+    if (field.rfind("shaper", 0) == 0) throw core::InputError(core::at_field("--shaper"), e.reason());
+    throw;
+  } catch (const std::domain_error& e) {
+    throw core::InputError(core::at_field("--controller"), e.what());
+  }
+}
+
+void print_frame_sequence(const vcnc::FrameSequence& run, const vcnc::FrameSequenceSettings& s,
+                          const std::string& structure, const std::string& plant_source) {
+  fmt::print("frame-sequence test, {} controller on {} (ts = {:.4g} s, {} samples): setpoint {:.4g} at 0 s{}, load "
+             "force {:.4g} at {:.4g} s, stator force {:.4g} at {:.4g} s\n",
+             structure, plant_source, run.ts, run.time.size(), s.setpoint,
+             s.shaper_times.empty() ? std::string()
+                                    : fmt::format(" through a {}-impulse shaper ({:.4g} s)", s.shaper_times.size(),
+                                                  s.shaper_times.back()),
+             s.load_force, s.load_step_time, s.stator_force, s.stator_step_time);
+  fmt::print("  {:<13} {:>12} {:>16} {:>15} {:>17}\n", "phase", "peak stator", "residual stator", "residual rotor",
+             "rotor peak error");
+  for (const vcnc::FramePhase& p : run.phases)
+    fmt::print("  {:<13} {:>12.4g} {:>16.4g} {:>15.4g} {:>17.4g}\n", p.name, p.peak_stator, p.residual_stator,
+               p.residual_rotor, p.peak_rotor_error);
+  fmt::print("  (residuals: RMS over the last {:.3g} s of each phase; rotor peak error: overshoot in the setpoint "
+             "phase)\n",
+             s.residual_window);
+  fmt::print("lightly damped closed-loop modes (damping < 0.3), amplitude each event leaves in the stator / rotor "
+             "velocity (setpoint, load force, stator force):\n");
+  for (std::size_t i = 0; i < run.phases[0].modes.size(); ++i) {
+    const vcnc::FrameMode& m = run.phases[0].modes[i];
+    if (m.damping >= 0.3) continue;
+    fmt::print("  {:8.4g} rad/s ({:.4g} Hz), damping {:.3g}: stator", std::abs(m.pole), std::abs(m.pole) / kTwoPi,
+               m.damping);
+    for (const vcnc::FramePhase& p : run.phases) fmt::print(" {:.3g}", p.modes[i].stator);
+    fmt::print(", rotor");
+    for (const vcnc::FramePhase& p : run.phases) fmt::print(" {:.3g}", p.modes[i].rotor);
+    fmt::print("\n");
+  }
+}
+
+int run_frame_sequence(const SimulateArgs& a, const GlobalOptions& global, const io::LoadedController& loaded,
+                       const machine::PlantConfig& plant, const std::string& plant_source,
+                       std::chrono::steady_clock::time_point start) {
+  if (!plant.frame)
+    throw core::InputError(core::at_field("--test"), "frame-sequence needs a flexible-frame plant (type flexible-frame "
+                                                     "or the preset c7.19-frame); " + plant_source + " is not one");
+  if (tuning::has_position_loop(loaded.controller.structure))
+    throw core::InputError(core::at_field("--test"), "frame-sequence is a velocity-loop test; this controller closes a "
+                                                     "position loop");
+  if (!a.report.empty())
+    throw core::InputError(core::at_field("--report"), "not available for the frame-sequence test (use -o for the CSV)");
+  const vcnc::FrameSequenceSettings s = frame_settings(a, plant.settings.ts);
+  auto out = a.out.empty() ? nullptr : open_output(a.out, global);
+  const vcnc::FrameSequence run = run_frame(*plant.frame, loaded.controller, s);
+  print_frame_sequence(run, s, tuning::to_string(loaded.controller.structure), plant_source);
+  if (out) {
+    io::write_frame_sequence_csv(out->stream(), run, s);
+    out->commit();
+    progress(global, "wrote {} ({} samples, {:.0f} ms)", a.out, run.time.size(), elapsed_ms(start));
+  }
+  return kSuccess;
+}
+
 int run(const SimulateArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   const io::LoadedController loaded = io::load_controller(a.controller);
   std::string plant_source;
   const machine::PlantConfig plant = plant_to_run(a, loaded, plant_source);
+  if (a.test == "frame-sequence") return run_frame_sequence(a, global, loaded, plant, plant_source, start);
+  if (!a.shaper.empty()) throw core::InputError(core::at_field("--shaper"), "only for --test frame-sequence");
   const auto report_file = open_report(a.report, global);
   auto out = a.out.empty() ? nullptr : open_output(a.out, global);
   const vcnc::DriveSimulation sim = simulate(plant, plant_source, loaded.controller, a.controller, settings_from(a));
@@ -133,11 +238,18 @@ void register_simulate(CLI::App& app, Action& selected) {
   cmd->add_option("--plant", a->plant,
                   "Plant description (servotwin.plant/1) or flexible preset name; default: the plant the controller "
                   "was tuned from, when that was a description or preset");
-  cmd->add_option("--test", a->test, "step: setpoint step (velocity; position for pi+p); load-step: load-torque step")
-      ->check(CLI::IsMember({"step", "load-step"}))
+  cmd->add_option("--test", a->test,
+                  "step: setpoint step (velocity; position for pi+p); load-step: load-torque step; frame-sequence: "
+                  "C7.19's setpoint, load-force and stator-force steps on a flexible-frame plant (linear)")
+      ->check(CLI::IsMember({"step", "load-step", "frame-sequence"}))
       ->capture_default_str();
+  cmd->add_option("--load-force", a->load_force, "frame-sequence: the load-force step")->capture_default_str();
+  cmd->add_option("--stator-force", a->stator_force, "frame-sequence: the stator-force step")->capture_default_str();
+  cmd->add_option("--shaper", a->shaper, "frame-sequence: shape the setpoint with this shaper (servotwin.shaper/1)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--amplitude", a->amplitude, "Step height in plant units (rad/s, rad or N m)")->capture_default_str();
-  cmd->add_option("--duration", a->duration, "Simulated time [s]; 0: from the design's settling horizon")
+  cmd->add_option("--duration", a->duration,
+                  "Simulated time [s]; 0: from the design's settling horizon (frame-sequence: 45 s, steps at the thirds)")
       ->capture_default_str();
   cmd->add_option("--torque-limit", a->torque_limit, "Limit of the torque command (anti-windup by conditional integration)");
   cmd->add_option("--band", a->band, "Settling band relative to the step")->capture_default_str();
@@ -146,7 +258,9 @@ void register_simulate(CLI::App& app, Action& selected) {
   set_examples(*cmd,
                "  servotwin tune motor-bench -o pi.json && servotwin simulate --controller pi.json -o step.csv\n"
                "  servotwin simulate --plant plant.json --controller pi.json --test load-step --amplitude 0.5 -o load.csv\n"
-               "  servotwin simulate --controller pi.json --torque-limit 2 --report step.html\n");
+               "  servotwin simulate --controller pi.json --torque-limit 2 --report step.html\n"
+               "  servotwin tune c7.19-frame --structure hinf --min-damping 0.15 -o h.json && "
+               "servotwin simulate --controller h.json --test frame-sequence -o frame.csv\n");
   cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });
 }
 

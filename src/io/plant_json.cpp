@@ -161,8 +161,7 @@ machine::TransferFunctionModel read_transfer_function(const Source& src) {
 // The four-mass frame enters as its rotor-velocity transfer function (eq. 7.172; times 1/s for a
 // position output): the linear design and the simulation need nothing more, and the file keeps
 // the physical parameters a user can read.
-machine::TransferFunctionModel read_flexible_frame(const Source& src, machine::PlantOutput output) {
-  const JsonObject& o = src.o;
+machine::FlexibleFrame read_frame(const JsonObject& o) {
   machine::FlexibleFrame f;
   f.frame_mass = positive(o, "frame_mass");
   f.frame_stiffness = positive(o, "frame_stiffness");
@@ -174,6 +173,11 @@ machine::TransferFunctionModel read_flexible_frame(const Source& src, machine::P
   f.coupling_stiffness = positive(o, "coupling_stiffness");
   f.coupling_damping = non_negative(o, "coupling_damping");
   f.load_mass = positive(o, "load_mass");
+  return f;
+}
+
+machine::TransferFunctionModel frame_model(const JsonObject& o, const machine::FlexibleFrame& f,
+                                           machine::PlantOutput output) {
   const core::TransferFunction velocity = machine::flexible_frame_transfer_function(f);
   switch (output) {
     case machine::PlantOutput::MotorVelocity:
@@ -320,7 +324,10 @@ machine::PlantConfig parse_plant_json(std::string_view text, std::string_view so
                           "\" (expected two-mass, mass-chain, transfer-function or flexible-frame)");
   }
   plant.settings = read_settings(src);
-  if (type == "flexible-frame") plant.model = read_flexible_frame(src, plant.settings.output);
+  if (type == "flexible-frame") {
+    plant.frame = read_frame(root);
+    plant.model = frame_model(root, *plant.frame, plant.settings.output);
+  }
   plant.name = root.string_or("name", std::filesystem::path(std::string(source_name)).stem().string());
   plant.description = root.string_or("description", "");
   try {
@@ -346,7 +353,15 @@ machine::PlantConfig load_plant(const std::string& name_or_path) {
 json plant_to_json(const machine::PlantConfig& plant) {
   machine::validate(plant);
   json j;
-  if (const auto* chain = std::get_if<machine::MassChain>(&plant.model)) {
+  if (plant.frame) {
+    const machine::FlexibleFrame& f = *plant.frame;
+    j = {{"type", "flexible-frame"},         {"frame_mass", f.frame_mass},
+         {"frame_stiffness", f.frame_stiffness}, {"frame_damping", f.frame_damping},
+         {"stator_mass", f.stator_mass},       {"mount_stiffness", f.mount_stiffness},
+         {"mount_damping", f.mount_damping},   {"rotor_mass", f.rotor_mass},
+         {"coupling_stiffness", f.coupling_stiffness}, {"coupling_damping", f.coupling_damping},
+         {"load_mass", f.load_mass}};
+  } else if (const auto* chain = std::get_if<machine::MassChain>(&plant.model)) {
     j = fits_two_mass(*chain) ? two_mass_to_json(*chain) : mass_chain_to_json(*chain);
   } else {
     const auto& tf = std::get<machine::TransferFunctionModel>(plant.model).tf;

@@ -213,6 +213,11 @@ void validate(const PlantConfig& config) {
   if (const auto* chain = std::get_if<MassChain>(&config.model)) validate_chain(*chain);
   else validate_transfer_function(std::get<TransferFunctionModel>(config.model).tf);
   validate_settings(config.settings);
+  if (config.frame) {
+    validate(*config.frame, "frame.");
+    if (!std::holds_alternative<TransferFunctionModel>(config.model))
+      detail::fail("frame", "a frame goes with its transfer-function model (eq. 7.172), not with a mass chain");
+  }
 }
 
 // ---- linear models -------------------------------------------------------------------------

@@ -110,12 +110,14 @@ PlantConfig motor_bench() {
 
 PlantConfig c7_19_frame() {
   const core::TransferFunction p = flexible_frame_transfer_function(c7_19_flexible_frame());
-  return tf_plant("c7.19-frame",
+  PlantConfig c = tf_plant("c7.19-frame",
                   "Flexible-frame four-mass example (dissertation sec. 7.6, eq. 7.175; catalog C7.19/E34): rotor "
                   "velocity in stator coordinates per motor force, eq. 7.172, m1 = 70, k1 = 4500, b1 = 0.01, m2 = 0.2, "
                   "k2 = 5, b2 = 0.02, m3 = 0.1, k3 = 0.1, b3 = 0.01, m4 = 0.2 (inferred); modes 1.22, 5.0, 8.03 rad/s; "
                   "ts 10 ms chosen",
                   p.num(), p.den(), 0.01, PlantOutput::MotorVelocity);
+  c.frame = c7_19_flexible_frame();
+  return c;
 }
 
 }  // namespace

@@ -115,6 +115,34 @@ TEST_F(Cli, TuneTheFlexibleFramePreset) {
   EXPECT_FALSE(std::filesystem::exists(path("pi.json")));
 }
 
+TEST_F(Cli, SimulateTheFrameSequence) {
+  // C7.19's three designs from the command line: the PI leaves the frame mode at damping ~0.1; a
+  // ZV shaper designed at that closed-loop mode removes it from the setpoint's response only (the
+  // printed amplitude drops below 1/20, the stator-force one stays); the CSV has every sample.
+  ASSERT_EQ(run("tune c7.19-frame -o pi.json").status, 0);
+  Result r = run("simulate --controller pi.json --test frame-sequence -o frame.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("frame-sequence test, pi controller on c7.19-frame"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("stator force"), std::string::npos) << r.out;
+  const std::string frame_line = "4.834 rad/s (0.7693 Hz), damping 0.0964: stator 0.191 0.000934 0.103";
+  EXPECT_NE(r.out.find(frame_line), std::string::npos) << r.out;
+  const std::string csv = slurp(path("frame.csv"));
+  EXPECT_EQ(csv.rfind("# servotwin.frame-sequence/1 ts=0.01", 0), 0U) << csv.substr(0, 200);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2 + 4501);
+  ASSERT_EQ(run("shaper design --type zv --freq-hz 0.7693 --zeta 0.0964 -o zv.json").status, 0);
+  r = run("simulate --controller pi.json --test frame-sequence --shaper zv.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("through a 2-impulse shaper"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("damping 0.0964: stator 0.00276 0.000971 0.103"), std::string::npos) << r.out;
+  // Refusals name the option: a plant without a frame, a shaper outside this test.
+  r = run("simulate --controller pi.json --plant table-5.1 --test frame-sequence");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("--test"), std::string::npos) << r.err;
+  r = run("simulate --controller pi.json --shaper zv.json");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("--shaper"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, TuneHinfOnATwoModePlant) {
   // C7.16's demo plant (eq. 7.165) as a transfer function: K (s^2 + 0.02 s + 1) * 4 (s^2 + 0.12 s + 36)
   // / (s (s^2 + 0.32 s + 16)(s^2 + 0.48 s + 144)); the default designs on the full model (active),

@@ -118,6 +118,10 @@ TEST(PlantJson, FlexibleFrameIsReadAsItsRotorVelocityTransferFunction) {
   EXPECT_EQ(model.tf.num(), preset.tf.num());
   EXPECT_EQ(model.tf.den(), preset.tf.den());
   EXPECT_EQ(model.tf.den().degree(), 7);
+  ASSERT_TRUE(frame.frame.has_value());  // kept for the frame-sequence test
+  EXPECT_EQ(frame.frame->load_mass, 0.2);
+  EXPECT_EQ(frame.frame->mount_stiffness, 5.0);
+  EXPECT_EQ(plant_to_json(frame)["type"], "flexible-frame");
   // A position output adds the integrator.
   const machine::PlantConfig position =
       parse_plant_json(frame_with(R"("ts": 0.01)", R"("ts": 0.01, "output": "motor_position")"), "frame.json");

@@ -32,6 +32,7 @@
 #include <Eigen/Dense>
 
 #include "servotwin/core/state_space.hpp"
+#include "servotwin/machine/flexible_frame.hpp"
 #include "servotwin/core/transfer_function.hpp"
 
 namespace servotwin::machine {
@@ -109,6 +110,10 @@ struct PlantConfig {
   std::string description;
   std::variant<MassChain, TransferFunctionModel> model;
   PlantSettings settings;
+  /// The four-mass frame a transfer-function model was made from (flexible_frame.hpp: the model is
+  /// its rotor velocity, eq. 7.172): what the frame's load- and stator-force test needs. Empty for
+  /// every other plant.
+  std::optional<FlexibleFrame> frame;
 };
 
 /// Checks every field; throws core::InputError naming the field (e.g. "inertia[1]",
