@@ -90,8 +90,22 @@ std::string controller_stability(const tuning::Controller& c) {
 Table comparison_table(const Context& c) {
   Table t;
   t.title = "Structures tuned to the same spec";
-  t.header = {"structure",      "design",          "load bandwidth [Hz]", "vs PI", "‖S‖∞", "tracking peak",
-              "‖ωl/Tl‖∞ [model units]", "vs PI", "ITAE load step", "vs PI", "phase margin [°]", "modulus margin",
+  const bool any_load = std::any_of(c.comparison.begin(), c.comparison.end(), [](const StructureComparison& e) {
+    return e.result && !std::isnan(e.result->controller.predicted.bandwidth_load);
+  });
+  t.header = {"structure",
+              "design",
+              any_load ? "load bandwidth [Hz]" : "motor bandwidth [Hz] (no load side)",
+              "vs PI",
+              "‖S‖∞",
+              "tracking peak",
+              "‖ωl/Tl‖∞ [model units]",
+              "vs PI",
+              "ITAE load step",
+              "vs PI",
+              "phase margin [°]",
+              "modulus margin",
+              "least damping",
               "controller"};
   const double hz = c.plant.omega_z / kTwoPi;
   for (const StructureComparison& e : c.comparison) {
@@ -111,7 +125,8 @@ Table comparison_table(const Context& c) {
                                                    i.peak_load_disturbance)),
                       num(i.itae_load_step), ratio(tuning::relative_to_pi(c.comparison, &LoopIndices::itae_load_step,
                                                                           i.itae_load_step)),
-                      num(i.phase_margin_deg, 3), num(i.modulus_margin, 3), controller_stability(k)});
+                      num(i.phase_margin_deg, 3), num(i.modulus_margin, 3), num(i.min_damping, 3),
+                      controller_stability(k)});
   }
   return t;
 }

@@ -10,7 +10,6 @@
 #include <numbers>
 #include <optional>
 #include <span>
-#include <utility>
 #include <vector>
 
 #include "checks.hpp"
@@ -312,8 +311,8 @@ void simulate_steps(std::span<const core::TransferFunction> tfs, double dt, std:
   }
 }
 
-// A closed-loop pole within this relative distance of both a zero and a pole of the loop gain L
-// belongs to a nearly cancelled pole-zero pair of L.
+// A closed-loop pole within this relative distance of both a zero and a pole of the plant (or of
+// the controller) belongs to a nearly cancelled pole-zero pair of that block.
 constexpr double kCancellationDistance = 1e-3;
 // Only lightly damped poles are tested for cancellation (a practically unobservable mode); the
 // real poles that set most horizons are not, which keeps the scans' cost unchanged.
@@ -438,7 +437,6 @@ LoopIndices analyse(const VelocityLoop& loop, const AnalysisOptions& options) {
   LoopIndices out;
   const ClosedLoopTransfer cl = loop.closed_loop();
   out.closed_loop_poles = cl.characteristic.roots();
-  out.min_damping = kInf;
   const std::vector<Complex> visible = visible_poles(loop, out.closed_loop_poles);
   out.min_damping = kInf;
   for (const Complex& p : visible) out.min_damping = std::min(out.min_damping, damping_of(p));

@@ -767,6 +767,10 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
     tune_cascade(result, options, check);
   }
   if (!plant.higher_modes.empty()) c.notes.push_back(higher_modes_note(options, plant.higher_modes));
+  if (options.min_damping && c.predicted.min_damping < *options.min_damping)
+    c.notes.push_back(fmt::format("least closed-loop damping {:.3g} is below --min-damping {:.3g}: the given design "
+                                  "parameter was kept (the automatic search enforces the floor)",
+                                  c.predicted.min_damping, *options.min_damping));
   if (!plant.higher_modes.empty() && !options.min_damping && c.predicted.min_damping < kLowDampingNote)
     c.notes.push_back(fmt::format(
         "least closed-loop damping {:.3g}: without a load side the search maximizes the motor bandwidth and may "

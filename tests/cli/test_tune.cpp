@@ -113,6 +113,12 @@ TEST_F(Cli, TuneTheFlexibleFramePreset) {
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("--min-damping"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(path("pi.json")));
+  // Compared without a load side, the table says it compares the motor, and shows the damping.
+  r = run("tune compare c7.19-frame --structures pi,hinf");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("spec: largest motor (no load side) bandwidth"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("motor bw [Hz]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("damping"), std::string::npos) << r.out;
 }
 
 TEST_F(Cli, SimulateTheFrameSequence) {
