@@ -499,6 +499,8 @@ class ControllerJsonErrors : public ::testing::Test {
 TEST_F(ControllerJsonErrors, UnmodifiedDocumentsRead) {
   for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP})
     EXPECT_EQ(with([](auto&) {}, s).message, "no error");
+  // Files written before --min-damping existed have no design.min_damping: still read.
+  EXPECT_EQ(with([](auto& c) { c["design"].erase("min_damping"); }, Structure::kPi).message, "no error");
 }
 
 TEST_F(ControllerJsonErrors, WrongFormat) {
