@@ -28,12 +28,8 @@ using detail::number;
 void finite(double v, const std::string& field) {
   if (!std::isfinite(v)) fail(field, "expected a finite number, found " + number(v));
 }
-void positive(double v, const std::string& field) {
-  if (!std::isfinite(v) || !(v > 0.0)) fail(field, "expected a finite number > 0, found " + number(v));
-}
-void non_negative(double v, const std::string& field) {
-  if (!std::isfinite(v) || v < 0.0) fail(field, "expected a finite number >= 0, found " + number(v));
-}
+using detail::non_negative;
+using detail::positive;
 void non_positive(double v, const std::string& field) {
   if (!std::isfinite(v) || v > 0.0) fail(field, "expected a finite number <= 0, found " + number(v));
 }

@@ -8,33 +8,18 @@
 
 namespace servotwin::machine {
 
-namespace {
-
-using core::Polynomial;
-
-void require_positive(double value, std::string_view prefix, const char* name) {
-  if (!(std::isfinite(value) && value > 0.0))
-    detail::fail(std::string(prefix) + name, "expected a finite number > 0, found " + detail::number(value));
-}
-
-void require_non_negative(double value, std::string_view prefix, const char* name) {
-  if (!(std::isfinite(value) && value >= 0.0))
-    detail::fail(std::string(prefix) + name, "expected a finite number >= 0, found " + detail::number(value));
-}
-
-}  // namespace
-
 void validate(const FlexibleFrame& f, std::string_view prefix) {
-  require_positive(f.frame_mass, prefix, "frame_mass");
-  require_positive(f.frame_stiffness, prefix, "frame_stiffness");
-  require_non_negative(f.frame_damping, prefix, "frame_damping");
-  require_positive(f.stator_mass, prefix, "stator_mass");
-  require_positive(f.mount_stiffness, prefix, "mount_stiffness");
-  require_non_negative(f.mount_damping, prefix, "mount_damping");
-  require_positive(f.rotor_mass, prefix, "rotor_mass");
-  require_positive(f.coupling_stiffness, prefix, "coupling_stiffness");
-  require_non_negative(f.coupling_damping, prefix, "coupling_damping");
-  require_positive(f.load_mass, prefix, "load_mass");
+  const auto field = [&](const char* name) { return std::string(prefix) + name; };
+  detail::positive(f.frame_mass, field("frame_mass"));
+  detail::positive(f.frame_stiffness, field("frame_stiffness"));
+  detail::non_negative(f.frame_damping, field("frame_damping"));
+  detail::positive(f.stator_mass, field("stator_mass"));
+  detail::positive(f.mount_stiffness, field("mount_stiffness"));
+  detail::non_negative(f.mount_damping, field("mount_damping"));
+  detail::positive(f.rotor_mass, field("rotor_mass"));
+  detail::positive(f.coupling_stiffness, field("coupling_stiffness"));
+  detail::non_negative(f.coupling_damping, field("coupling_damping"));
+  detail::positive(f.load_mass, field("load_mass"));
 }
 
 FlexibleFrame c7_19_flexible_frame() noexcept {
@@ -129,6 +114,7 @@ core::TransferFunction flexible_frame_transfer_function(const FlexibleFrame& f) 
   const double m1 = f.frame_mass, m2 = f.stator_mass, m3 = f.rotor_mass, m4 = f.load_mass;
   const double k1 = f.frame_stiffness, k2 = f.mount_stiffness, k3 = f.coupling_stiffness;
   const double b1 = f.frame_damping, b2 = f.mount_damping, b3 = f.coupling_damping;
+  using core::Polynomial;
   const Polynomial s{1.0, 0.0};
   // Eq. 7.172, Pm = bm/am (rotor and load) and Pf = bs/as (stator and frame).
   const Polynomial bm{m4, b3, k3};

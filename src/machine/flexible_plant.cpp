@@ -27,12 +27,8 @@ constexpr int kMaxDelaySamples = 100000;
 using detail::fail;
 using detail::number;
 
-void positive(double v, const std::string& field) {
-  if (!std::isfinite(v) || !(v > 0.0)) fail(field, "expected a finite number > 0, found " + number(v));
-}
-void non_negative(double v, const std::string& field) {
-  if (!std::isfinite(v) || v < 0.0) fail(field, "expected a finite number >= 0, found " + number(v));
-}
+using detail::non_negative;
+using detail::positive;
 std::string indexed(const char* name, std::size_t i) { return std::string(name) + "[" + std::to_string(i) + "]"; }
 
 void validate_chain(const MassChain& c) {
