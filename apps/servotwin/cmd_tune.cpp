@@ -219,6 +219,10 @@ std::vector<vcnc::DriveSimulation> verify_on_plant(const TunePlant& plant, const
     fmt::print("verified by simulation on the plant with its nonlinearities:\n");
     runs.push_back(vcnc::simulate_drive(*plant.description, controller));
     print_verification(runs.back());
+    if (!vcnc::has_load_torque_input(*plant.description)) {
+      fmt::print("  load step: not simulated (a transfer-function plant has no load-torque input)\n");
+      return runs;
+    }
     vcnc::DriveSimulationSettings load;
     load.test = vcnc::DriveTest::kLoadStep;
     load.amplitude = runs.back().linear_metrics.peak_torque;

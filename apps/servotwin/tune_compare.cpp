@@ -110,12 +110,20 @@ std::vector<vcnc::DriveSimulation> simulate_on_plant(const TunePlant& plant,
     const std::string name = tuning::to_string(c.structure);
     try {
       const vcnc::DriveSimulation step = vcnc::simulate_drive(*plant.description, c.result->controller);
+      const vcnc::DriveMetrics &m = step.metrics, &l = step.linear_metrics;
+      if (!vcnc::has_load_torque_input(*plant.description)) {
+        fmt::print("{:<6} {:>10.1f} / {:>8.1f} {:>11} / {:>9} {:>12.3g} | {:>19}\n", name, 100.0 * m.overshoot,
+                   100.0 * l.overshoot, time_or_never(m.settling_time), time_or_never(l.settling_time), m.final_error,
+                   "n/a (no load input)");
+        runs.push_back(step);
+        continue;
+      }
       if (!load_torque) load_torque = step.linear_metrics.peak_torque;
       vcnc::DriveSimulationSettings settings;
       settings.test = vcnc::DriveTest::kLoadStep;
       settings.amplitude = *load_torque;
       const vcnc::DriveSimulation load = vcnc::simulate_drive(*plant.description, c.result->controller, settings);
-      const vcnc::DriveMetrics &m = step.metrics, &l = step.linear_metrics, &ml = load.metrics, &ll = load.linear_metrics;
+      const vcnc::DriveMetrics &ml = load.metrics, &ll = load.linear_metrics;
       fmt::print("{:<6} {:>10.1f} / {:>8.1f} {:>11} / {:>9} {:>12.3g} | {:>9.4g} / {:>7.4g} {:>11} / {:>9}\n", name,
                  100.0 * m.overshoot, 100.0 * l.overshoot, time_or_never(m.settling_time), time_or_never(l.settling_time),
                  m.final_error, ml.peak_deviation, ll.peak_deviation, time_or_never(ml.recovery_time),

@@ -163,11 +163,13 @@ Table hf_table(const Context& c) {
 }
 
 std::optional<Table> two_mass_table(const Context& c) {
-  const std::optional<tuning::FrictionTwoMass> f = tuning::physical_parameters_with_friction(c.plant);
+  const std::optional<tuning::FrictionTwoMass> f = tuning::two_mass_realization(c.plant);
   if (!f) return std::nullopt;
   const tuning::PhysicalTwoMass q = tuning::to_physical(*f, c.plant);
   Table t;
-  t.title = "Two-mass realization with viscous friction (model units)";
+  t.title = f->passive() ? "Two-mass realization with viscous friction (model units)"
+                         : "Two-mass realization with viscous friction (model units; not passive: the load side is an "
+                           "estimate)";
   t.header = {"parameter", "value"};
   t.rows.push_back({"motor inertia Im", num(q.motor_inertia)});
   t.rows.push_back({"load inertia Il", num(q.load_inertia)});
@@ -554,8 +556,8 @@ Section loop_section(const Context& c, const tuning::VelocityLoop& loop) {
       "reference) and the feedback controller C(s). Peaks and margins are the analysis' values (grid plus "
       "refinement).";
   if (!loop.has_load())
-    s.text +=
-        " The plant has no two-mass realization (higher modes or negative friction terms): no load-side functions.";
+    s.text += " The plant has higher modes or no two-mass realization (its shaft damping would be negative): no "
+              "load-side functions.";
   s.tables.push_back(margins_table(c));
   s.charts = loop_charts(c, loop);
   return s;

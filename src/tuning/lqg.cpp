@@ -28,8 +28,10 @@ void check_plant(const FrictionTwoMass& p, double r) {
   detail::require_positive(p.load_inertia, "load_inertia", "a load inertia");
   detail::require_ratio(r, "r");
   detail::require_non_negative(p.damping, "damping", "a shaft damping");
-  detail::require_non_negative(p.motor_viscous, "motor_viscous", "a viscous friction");
-  detail::require_non_negative(p.load_viscous, "load_viscous", "a viscous friction");
+  // The friction terms may be negative: the exact realization of a fit that is not passive
+  // (two_mass_realization()) is still a valid design model.
+  detail::require_finite(p.motor_viscous, "motor_viscous");
+  detail::require_finite(p.load_viscous, "load_viscous");
 }
 
 /// ρ = kbw/c² with c = r²/2 (C7.13).

@@ -200,7 +200,7 @@ core::TransferFunction NormalizedPlant::motor(bool with_higher_modes) const {
 }
 
 std::optional<core::TransferFunction> NormalizedPlant::load() const {
-  const std::optional<FrictionTwoMass> p = physical_parameters_with_friction(*this);
+  const std::optional<FrictionTwoMass> p = two_mass_realization(*this);
   if (!p) return std::nullopt;
   return core::TransferFunction(Polynomial{p->damping / p->stiffness, 1.0},
                                 Polynomial{1.0, a} * Polynomial{1.0, 2.0 * zeta_p * r, r * r});
@@ -267,7 +267,11 @@ NormalizedPlant normalized_two_mass(double r, double zeta_z, std::optional<doubl
 
 // ---------------------------------------------------------------- two-mass realization (plan §1.1)
 
-std::optional<FrictionTwoMass> physical_parameters_with_friction(const NormalizedPlant& plant) {
+bool FrictionTwoMass::passive() const noexcept {
+  return damping >= 0.0 && motor_viscous >= 0.0 && load_viscous >= 0.0;
+}
+
+std::optional<FrictionTwoMass> two_mass_realization(const NormalizedPlant& plant) {
   if (!plant.higher_modes.empty() || !(plant.zeta_z < 1.0)) return std::nullopt;
   const double r = plant.r, zz = plant.zeta_z, zp = plant.zeta_p, a = plant.a;
   const double alpha = (a * (r * r - 1.0) + 2.0 * zz - 2.0 * zp * r) / 2.0;
@@ -285,9 +289,15 @@ std::optional<FrictionTwoMass> physical_parameters_with_friction(const Normalize
   m.motor_viscous = a * r * r - m.load_viscous;
   const double rounding = 1e-10 * (1.0 + f);
   for (double* v : {&m.load_viscous, &m.damping, &m.motor_viscous}) {
-    if (*v < -rounding) return std::nullopt;
-    if (*v <= rounding) *v = 0.0;
+    if (std::abs(*v) <= rounding) *v = 0.0;
   }
+  if (m.damping < 0.0) return std::nullopt;
+  return m;
+}
+
+std::optional<FrictionTwoMass> physical_parameters_with_friction(const NormalizedPlant& plant) {
+  std::optional<FrictionTwoMass> m = two_mass_realization(plant);
+  if (m && !m->passive()) return std::nullopt;
   return m;
 }
 

@@ -71,8 +71,23 @@ void validate(const TuneOptions& o) {
 /// What the automatic searches maximize: the load tracking bandwidth where the plant has a load
 /// side (a two-mass realization, as VelocityLoop::has_load()), else the motor's.
 std::string largest_bandwidth(const NormalizedPlant& plant) {
-  const bool load = plant.higher_modes.empty() && physical_parameters_with_friction(plant).has_value();
+  const bool load = plant.higher_modes.empty() && two_mass_realization(plant).has_value();
   return load ? "largest load bandwidth" : "largest motor bandwidth (no load side)";
+}
+
+/// A note when the first mode's two-mass realization is not passive: its load side (the load
+/// bandwidth and peaks, the LQG's design model, the position loop) is then an estimate.
+std::optional<std::string> estimated_load_note(const NormalizedPlant& plant) {
+  NormalizedPlant first = plant;
+  first.higher_modes.clear();
+  const std::optional<FrictionTwoMass> m = two_mass_realization(first);
+  if (!m || m->passive()) return std::nullopt;
+  return fmt::format("the load side is an estimate: the fit has no passive two-mass realization (antiresonance "
+                     "damping {:.3g} against resonance damping {:.3g}); its exact realization needs shaft damping "
+                     "b = {:.3g}, load friction bl = {:.3g} and motor friction bm = {:.3g} (normalized), and a motor "
+                     "measurement cannot tell where the damping sits: load bandwidth, load peaks and full-order "
+                     "designs rest on that reading",
+                     plant.zeta_z, plant.zeta_p, m->damping, m->load_viscous, m->motor_viscous);
 }
 
 /// The frequency grid of the scan: wide enough for every loop function of a normalized plant.
@@ -358,11 +373,11 @@ struct LqgDesigner {
 FrictionTwoMass lqg_design_model(const NormalizedPlant& plant, Structure structure) {
   NormalizedPlant first = plant;
   first.higher_modes.clear();
-  const std::optional<FrictionTwoMass> m = physical_parameters_with_friction(first);
+  const std::optional<FrictionTwoMass> m = two_mass_realization(first);
   if (!m) {
     throw InputError(at_field("--structure"),
-                     to_string(structure) + " needs a two-mass realization with non-negative friction, and this plant "
-                     "has none (its friction terms would be negative); use --structure pi or pid");
+                     to_string(structure) + " needs a two-mass realization, and this plant has none (its shaft "
+                     "damping would be negative); use --structure pi or pid");
   }
   return *m;
 }
@@ -767,6 +782,7 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
     tune_cascade(result, options, check);
   }
   if (!plant.higher_modes.empty()) c.notes.push_back(higher_modes_note(options, plant.higher_modes));
+  if (const std::optional<std::string> note = estimated_load_note(plant)) c.notes.push_back(*note);
   if (options.min_damping && c.predicted.min_damping < *options.min_damping)
     c.notes.push_back(fmt::format("least closed-loop damping {:.3g} is below --min-damping {:.3g}: the given design "
                                   "parameter was kept (the automatic search enforces the floor)",

@@ -65,7 +65,7 @@ ControllerTf pid_controller(const PidGains& g) {
 }
 
 std::optional<TwoMassTransfer> two_mass_transfer(const NormalizedPlant& plant) {
-  const std::optional<FrictionTwoMass> m = physical_parameters_with_friction(plant);
+  const std::optional<FrictionTwoMass> m = two_mass_realization(plant);
   if (!m) return std::nullopt;
   // Every function over the monic (s + a)(s² + 2ζp r s + r²) = D'/Il (plan §1.1 realization).
   const TransferFunction motor = plant.motor(false);
@@ -126,7 +126,7 @@ VelocityLoop::VelocityLoop(const NormalizedPlant& plant, ControllerTf controller
     fb_den_ = fb.den();
     delay_ = p.hf.delay_s.value_or(0.0);
   }
-  if (const std::optional<FrictionTwoMass> m = p.higher_modes.empty() ? physical_parameters_with_friction(p)
+  if (const std::optional<FrictionTwoMass> m = p.higher_modes.empty() ? two_mass_realization(p)
                                                                         : std::nullopt) {
     const std::optional<TwoMassTransfer> tm = two_mass_transfer(p);
     has_load_ = tm.has_value();

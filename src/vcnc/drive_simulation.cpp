@@ -44,8 +44,7 @@ void check_plant(const machine::PlantConfig& plant, const tuning::Controller& co
     fail("settings.output", fmt::format("a motor-side output (motor_velocity or motor_position) for the cascade "
                                         "controller, which feeds back the motor; the plant measures {}",
                                         machine::to_string(output)));
-  const bool chain = std::holds_alternative<machine::MassChain>(plant.model);
-  if (test == DriveTest::kLoadStep && !chain)
+  if (test == DriveTest::kLoadStep && !has_load_torque_input(plant))
     fail("model", "a mass chain for the load-step test: a transfer-function plant has no load-torque input");
   if (is_position_loop(controller) && !controller.kpp_physical)
     fail("controller.kpp_physical", "the position gain of a " + tuning::to_string(controller.structure) + " controller");
@@ -294,6 +293,10 @@ std::optional<DriveTest> drive_test_from_string(std::string_view text) noexcept 
   if (text == "step") return DriveTest::kSetpointStep;
   if (text == "load-step") return DriveTest::kLoadStep;
   return std::nullopt;
+}
+
+bool has_load_torque_input(const machine::PlantConfig& plant) noexcept {
+  return std::holds_alternative<machine::MassChain>(plant.model);
 }
 
 ControlledVariable controlled_variable(const DriveSimulation& simulation) noexcept {

@@ -121,6 +121,24 @@ TEST_F(Cli, TuneTheFlexibleFramePreset) {
   EXPECT_NE(r.out.find("damping"), std::string::npos) << r.out;
 }
 
+TEST_F(Cli, CompareOnTheTestBedEstimatesTheLoadSide) {
+  // Catalog A6 configuration 2 at the printed Ms = Mt = 2.5: the fit has no passive two-mass
+  // realization, the comparison runs on the load side of its exact realization and says so; the
+  // transfer-function plant has no load-torque input, so the step is verified and the load step is
+  // marked, not the whole row dropped.
+  const Result r = run("tune compare testbed-2 --structures pi,hinf --ms 2.5 --mt 2.5");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("load bw [Hz]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("n/a (no load input)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("not simulated"), std::string::npos) << r.out;
+  const Result t = run("tune testbed-2 --structure hinf --ms 2.5 --mt 2.5 -o tb.json");
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("note: the load side is an estimate"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("step of 1: overshoot"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("load step: not simulated (a transfer-function plant has no load-torque input)"),
+            std::string::npos) << t.out;
+}
+
 TEST_F(Cli, SimulateTheFrameSequence) {
   // C7.19's three designs from the command line: the PI leaves the frame mode at damping ~0.1; a
   // ZV shaper designed at that closed-loop mode removes it from the setpoint's response only (the

@@ -269,12 +269,52 @@ TEST(FrictionTwoMass, RandomPhysicalPlantsRoundTrip) {
   }
 }
 
-TEST(FrictionTwoMass, NoRealizationWhenFrictionWouldBeNegative) {
-  // Integrator plant with ζp ≠ r ζz: bm + bl = a r² = 0 forces bm = −bl ≠ 0.
-  EXPECT_FALSE(physical_parameters_with_friction(normalized_two_mass(3.0, 0.01, 0.05)).has_value());
-  EXPECT_FALSE(normalized_two_mass(3.0, 0.01, 0.05).load().has_value());
-  // Pole damping far below what the antiresonance damping implies (b < 0 would be needed).
+TEST(FrictionTwoMass, NoPassiveRealizationWhenFrictionWouldBeNegative) {
+  // Integrator plant with ζp ≠ r ζz: bm + bl = a r² = 0 forces bm = −bl ≠ 0. The realization still
+  // exists (exact for the motor, checked below) but is not passive.
+  const NormalizedPlant integrating = normalized_two_mass(3.0, 0.01, 0.05);
+  EXPECT_FALSE(physical_parameters_with_friction(integrating).has_value());
+  const std::optional<FrictionTwoMass> m = two_mass_realization(integrating);
+  ASSERT_TRUE(m.has_value());
+  EXPECT_FALSE(m->passive());
+  EXPECT_LT(std::abs(m->motor_viscous + m->load_viscous), 1e-12);
+  EXPECT_TRUE(integrating.load().has_value());
+  // Pole damping far below what the antiresonance damping implies: load friction with negative
+  // motor friction (numpy on the closed form: b = 1.46789, bl = 1.88789, bm = −1.79789).
+  const std::optional<FrictionTwoMass> heavy = two_mass_realization(normalized_two_mass(3.0, 0.2, 0.01, 0.01));
+  ASSERT_TRUE(heavy.has_value());
   EXPECT_FALSE(physical_parameters_with_friction(normalized_two_mass(3.0, 0.2, 0.01, 0.01)).has_value());
+  EXPECT_NEAR(heavy->damping, 1.46789, 1e-5);
+  EXPECT_NEAR(heavy->motor_viscous, -1.79789, 1e-5);
+  // A rigid pole fast against a lightly damped antiresonance: the shaft damping b would be negative
+  // (numpy: b = −1.83526), a non-minimum-phase load; no two-mass reading at all.
+  const NormalizedPlant fast_rigid = normalized_two_mass(3.0, 0.01, 0.03, 0.5);
+  EXPECT_FALSE(two_mass_realization(fast_rigid).has_value());
+  EXPECT_FALSE(fast_rigid.load().has_value());
+}
+
+TEST(FrictionTwoMass, TestBedFitsHaveAnExactRealizationWithNegativeMotorFriction) {
+  // Catalog A6 configuration 2 (eq. 8.14): antiresonance 49.9 rad/s ζ 0.24, resonance 254 rad/s
+  // ζ 0.02, rigid pole 0.15 rad/s. Expected values: the closed form of the realization evaluated
+  // by hand in numpy (f = 26.4841, b = 6.18055, bl = 6.53182, bm = −6.45394, normalized), and the
+  // motor and load responses of the equations of motion (physical_tfs) against the design model.
+  const NormalizedPlant p = normalize(two_mass_model(454.5, fit::RigidKind::kRealPole, 0.15, {49.9, 0.24}, {254.0, 0.02}));
+  const std::optional<FrictionTwoMass> m = two_mass_realization(p);
+  ASSERT_TRUE(m.has_value());
+  EXPECT_FALSE(m->passive());
+  EXPECT_NEAR(m->load_inertia, 26.4841, 1e-4);
+  EXPECT_NEAR(m->damping, 6.18055, 1e-5);
+  EXPECT_NEAR(m->load_viscous, 6.53182, 1e-5);
+  EXPECT_NEAR(m->motor_viscous, -6.45394, 1e-5);
+  const PhysicalTfs tf = physical_tfs(to_physical(*m, p));
+  const std::optional<core::TransferFunction> load = p.load();
+  ASSERT_TRUE(load.has_value());
+  const double scale = p.motor_inertia * p.omega_z;
+  for (double w : core::log_space(0.01, 100.0, 41)) {
+    const double physical = p.physical_frequency(w);
+    EXPECT_LT(std::abs(tf.motor.frequency_response(physical) * scale / p.motor(false).frequency_response(w) - 1.0), 1e-10);
+    EXPECT_LT(std::abs(tf.load.frequency_response(physical) * scale / load->frequency_response(w) - 1.0), 1e-10);
+  }
 }
 
 TEST(Normalize, BadInputsNameTheProblem) {

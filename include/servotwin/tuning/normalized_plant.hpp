@@ -76,8 +76,8 @@ struct NormalizedPlant {
   /// (plan §1.1), so both agree at low frequency. HF dynamics are never included.
   [[nodiscard]] core::TransferFunction motor(bool with_higher_modes = true) const;
   /// Load velocity per motor torque ωl/Tm of the two-mass realization (with viscous friction when
-  /// a > 0 or ζp ≠ r ζz): (b s + k)/(k (s + a)(s² + 2ζp r s + r²)), from
-  /// physical_parameters_with_friction(). std::nullopt when there are higher modes or no
+  /// a > 0 or ζp ≠ r ζz): (b s + k)/(k (s + a)(s² + 2ζp r s + r²)), from two_mass_realization()
+  /// (an estimate when that is not passive). std::nullopt when there are higher modes or no
   /// two-mass realization exists.
   [[nodiscard]] std::optional<core::TransferFunction> load() const;
   /// The measured output per torque at normalized frequency ω, with higher modes and HF
@@ -121,6 +121,10 @@ struct FrictionTwoMass {
   double damping = 0.0;        ///< b (shaft)
   double motor_viscous = 0.0;  ///< bm
   double load_viscous = 0.0;   ///< bl
+
+  /// True when every friction term b, bm, bl is >= 0: a passive two-mass system. A realization
+  /// that is not passive is still exact for the motor side; its load side is an estimate.
+  [[nodiscard]] bool passive() const noexcept;
 };
 
 /// Physical two-mass parameters (units of the fitted model: inertia, N·m/rad, N·m·s/rad).
@@ -133,8 +137,17 @@ struct PhysicalTwoMass {
 /// 7.73–7.74): k = Il = f, α = (a(r²−1) + 2ζz − 2ζp r)/2, bl = α + ζz f, b = 2ζz f − bl,
 /// bm = a r² − bl, with f the positive root of (1−ζz²) f² + (1 − r² + 2aζz r² − 2aζp r − 2αζz) f − α² = 0
 /// (the product of the roots is <= 0, so one root is >= 0). b, bl, bm within ±1e-10·(1 + f) of 0
-/// are rounding and reported as 0. std::nullopt when b, bl or bm is negative beyond that ("not a
-/// two-mass system with viscous friction"), when ζz >= 1, or when the plant has higher modes.
+/// are rounding and reported as 0. The realization is unique and exact for Pm whatever the signs
+/// of bm and bl: a fit whose antiresonance is damped more than its rigid pole allows (the test
+/// beds of catalog A6: ζz = 0.19 with ζp = 0.02 and a ≈ 0) comes out with bl > 0 and bm ≈ −bl.
+/// Such a realization is not passive (FrictionTwoMass::passive()) and its load side is an
+/// estimate: a motor-side measurement cannot tell where the damping sits. std::nullopt when
+/// ζz >= 1, when the plant has higher modes, or when the shaft damping b would be negative (the
+/// load would respond with a non-minimum-phase zero: no two-mass reading of the fit at all).
+[[nodiscard]] std::optional<FrictionTwoMass> two_mass_realization(const NormalizedPlant& plant);
+
+/// two_mass_realization() when it is passive (b, bl, bm >= 0), else std::nullopt ("not a
+/// two-mass system with viscous friction").
 [[nodiscard]] std::optional<FrictionTwoMass> physical_parameters_with_friction(const NormalizedPlant& plant);
 
 /// De-normalizes a two-mass realization: Il = f·Im, k = f·Im·ωz², b, bm, bl times Im·ωz.

@@ -16,7 +16,8 @@
 ///   L = C·F·A·Pm,  S = 1/(1 + L),  T = L/(1 + L).
 ///
 /// Load-side functions exist only for a plant with a two-mass realization
-/// (physical_parameters_with_friction()); with higher modes they are std::nullopt.
+/// (two_mass_realization(); an estimate when it is not passive); with higher modes they are
+/// std::nullopt.
 
 #include <complex>
 #include <optional>

@@ -134,6 +134,10 @@ struct DriveSimulation {
 /// stiffnesses, shaft damping, viscous friction, current lag and delay kept).
 [[nodiscard]] machine::PlantConfig linear_part(const machine::PlantConfig& plant);
 
+/// True when `plant` has a load-torque input for DriveTest::kLoadStep (a mass chain; a
+/// transfer-function plant has none).
+[[nodiscard]] bool has_load_torque_input(const machine::PlantConfig& plant) noexcept;
+
 /// Runs `settings.test` on `plant` closed by `controller` (and on its linear part). Throws
 /// core::InputError naming the field when the plant cannot be run with this controller: a
 /// load-side output, a load step on a transfer-function plant, a pi+p controller without its
