@@ -41,6 +41,11 @@ void add_spec_options(CLI::App& cmd, TuneSpecArgs& a) {
   cmd.add_option("--min-damping", a.min_damping,
                  "Least damping of the visible closed-loop poles (0..1): also required by the automatic search; "
                  "for plants with higher modes, where a pole near an antiresonance can leave the load or frame ringing");
+  cmd.add_option("--load-side", a.load_side,
+                 "Where the load is: auto (a two-mass plant's load; none with higher modes) or chain (the higher modes "
+                 "lie in the drive train between motor and load, e.g. a test bed: estimate the load through them)")
+      ->check(CLI::IsMember({"auto", "chain"}))
+      ->capture_default_str();
   cmd.add_option("--w2-num", a.w2_num, "Uncertainty weight W2(s) numerator, descending powers of s [rad/s], e.g. \"2.6,0\"");
   cmd.add_option("--w2-den", a.w2_den, "Uncertainty weight W2(s) denominator, e.g. \"1,15\"");
   cmd.add_option("--w2-from-frf", a.w2_from_frf,
@@ -58,6 +63,7 @@ void apply_spec(const TuneSpecArgs& a, const TunePlant& plant, tuning::TuneOptio
   o.ms = a.ms;
   o.mt = a.mt;
   o.min_damping = a.min_damping;
+  o.chain_load = a.load_side == "chain";
   if (a.w2_num.empty() != a.w2_den.empty()) {
     throw core::InputError(core::at_field(a.w2_num.empty() ? "--w2-num" : "--w2-den"), "give both --w2-num and --w2-den");
   }

@@ -18,9 +18,10 @@ struct TuneSpecArgs {
   std::string w2_num, w2_den, w2_from_frf;
   int w2_order = 1;
   std::optional<double> current_lag, filter, delay, ts, min_damping;
+  std::string load_side = "auto";
 };
 
-/// Adds --ms, --mt, --min-damping, --w2-num/--w2-den, --w2-from-frf, --w2-order, --current-lag, --filter, --delay
+/// Adds --ms, --mt, --min-damping, --load-side, --w2-num/--w2-den, --w2-from-frf, --w2-order, --current-lag, --filter, --delay
 /// and --ts to `cmd`.
 void add_spec_options(CLI::App& cmd, TuneSpecArgs& args);
 

@@ -163,11 +163,11 @@ Section loop_section(const Context& c) {
   Chart disturbance = frequency_chart("Load-torque response |ωl/Tl| (velocity per torque)", "magnitude [dB]");
   for (const Designed& d : c.designs) {
     const std::string name = label(d.entry);
-    const bool load = d.loop.has_load();
+    const bool load = d.loop.has_load_tracking();
     tracking.series.push_back(
         {name, c.hz, db_of(sampled(c.omega, [&](double w) { return load ? d.loop.load_tracking(w) : d.loop.motor_tracking(w); }))});
     sensitivity.series.push_back({name, c.hz, db_of(sampled(c.omega, [&](double w) { return d.loop.sensitivity(w); }))});
-    if (load)
+    if (d.loop.has_load())
       disturbance.series.push_back(
           {name, c.hz,
            db_of(sampled(c.omega, [&](double w) { return d.loop.load_from_load_torque(w); }), c.velocity_per_torque())});

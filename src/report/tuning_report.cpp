@@ -530,7 +530,7 @@ std::vector<Chart> loop_charts(const Context& c, const tuning::VelocityLoop& loo
   shapes.series.push_back({"|S|", c.hz, db_of(s)});
   shapes.series.push_back({"|T|", c.hz, db_of(t)});
   shapes.series.push_back({"|ωm/ω*|", c.hz, db_of(tm)});
-  if (loop.has_load()) shapes.series.push_back({"|ωl/ω*|", c.hz, db_of(tl)});
+  if (loop.has_load_tracking()) shapes.series.push_back({"|ωl/ω*|", c.hz, db_of(tl)});
   if (d.ms) shapes.series.push_back(flat(fmt::format("Ms = {}", num(*d.ms, 3)), c.hz, db(*d.ms)));
   if (d.mt) shapes.series.push_back(flat(fmt::format("Mt = {}", num(*d.mt, 3)), c.hz, db(*d.mt)));
   std::vector<Chart> charts{std::move(shapes)};
@@ -555,9 +555,12 @@ Section loop_section(const Context& c, const tuning::VelocityLoop& loop) {
       "reference, the load velocity per load torque (closed loop against the uncontrolled plant: J2's "
       "reference) and the feedback controller C(s). Peaks and margins are the analysis' values (grid plus "
       "refinement).";
-  if (!loop.has_load())
+  if (!loop.has_load_tracking())
     s.text += " The plant has higher modes or no two-mass realization (its shaft damping would be negative): no "
               "load-side functions.";
+  else if (!loop.has_load())
+    s.text += " The higher modes are read as couplings of the drive train (--load-side chain): the load tracking "
+              "is an estimate and there are no load-torque functions.";
   s.tables.push_back(margins_table(c));
   s.charts = loop_charts(c, loop);
   return s;
@@ -768,7 +771,7 @@ Document tuning_report(const tuning::TuneResult& result, const TuningReportOptio
                              : f ? fmt::format("kbw = {}", num(f->weights.kbw, 4))
                                  : fmt::format("ω* = {} Hz", num(c.to_hz(result.controller.design.omega_star), 4)));
   doc.sections.push_back(plant_section(c));
-  doc.sections.push_back(design_section(c, loop.has_load()));
+  doc.sections.push_back(design_section(c, loop.has_load_tracking()));
   doc.sections.push_back(loop_section(c, loop));
   doc.sections.push_back(robustness_section(c, loop, w2n));
   const tuning::VelocityLoop base = position_base(c, loop);

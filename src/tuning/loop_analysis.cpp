@@ -178,7 +178,9 @@ void frequency_indices(const VelocityLoop& loop, const ClosedLoopTransfer& cl, s
                        const AnalysisOptions& o, LoopIndices& out) {
   const std::size_t n = grid.size();
   const bool load = loop.has_load();
-  const std::size_t channels = load ? kChannels : kTl;  // the load channels follow kTm
+  const bool tracking = loop.has_load_tracking();
+  // The load channels follow kTm: kTl alone for a modal plant's estimated load tracking.
+  const std::size_t channels = load ? kChannels : tracking ? kTl + 1 : kTl;
   Workspace& ws = workspace();
   ws.mags.resize(kChannels * n);
   ws.l.resize(n);
@@ -191,8 +193,8 @@ void frequency_indices(const VelocityLoop& loop, const ClosedLoopTransfer& cl, s
     mags[kS * n + i] = magnitude(r.sensitivity);
     mags[kT * n + i] = magnitude(r.complementary);
     mags[kTm * n + i] = magnitude(r.motor_tracking);
+    if (tracking) mags[kTl * n + i] = magnitude(r.load_tracking);
     if (!load) continue;
-    mags[kTl * n + i] = magnitude(r.load_tracking);
     mags[kLoadDist * n + i] = magnitude(r.load_from_load_torque);
     mags[kLoadDistW * n + i] = magnitude(r.load_from_load_torque * weight(w));
     mags[kOpenW * n + i] = magnitude(r.open_loop_load_from_load_torque * weight(w));
@@ -210,15 +212,16 @@ void frequency_indices(const VelocityLoop& loop, const ClosedLoopTransfer& cl, s
   out.bandwidth_motor = bandwidth_from_samples([&loop](double w) { return loop.motor_tracking(w); },
                                                cl.motor_tracking.dc_gain(), grid,
                                                mags.subspan(kTm * n, n));
-  if (load) {
+  out.peak_tl = out.peak_load_disturbance = out.j2 = out.bandwidth_load = kNaN;
+  if (tracking) {
     out.peak_tl = peaks[kTl].value;
-    out.peak_load_disturbance = peaks[kLoadDist].value;
-    out.j2 = peaks[kLoadDistW].value / peaks[kOpenW].value;
     out.bandwidth_load = bandwidth_from_samples([&loop](double w) { return loop.load_tracking(w); },
                                                 cl.load_tracking->dc_gain(), grid,
                                                 mags.subspan(kTl * n, n));
-  } else {
-    out.peak_tl = out.peak_load_disturbance = out.j2 = out.bandwidth_load = kNaN;
+  }
+  if (load) {
+    out.peak_load_disturbance = peaks[kLoadDist].value;
+    out.j2 = peaks[kLoadDistW].value / peaks[kOpenW].value;
   }
   margins(loop, grid, l, out);
 }
@@ -325,8 +328,10 @@ bool near_any(const Complex& p, const std::vector<Complex>& roots) {
 
 double damping_of(const Complex& p) { return std::abs(p) > 0.0 ? -p.real() / std::abs(p) : 1.0; }
 
-void time_indices(const ClosedLoopTransfer& cl, const std::vector<Complex>& visible, bool load,
-                  const AnalysisOptions& o, LoopIndices& out) {
+void time_indices(const ClosedLoopTransfer& cl, const std::vector<Complex>& visible, const AnalysisOptions& o,
+                  LoopIndices& out) {
+  const bool tracking = cl.load_tracking.has_value();
+  const bool load = cl.load_from_load_torque.has_value();
   double fastest = 0.0;
   double slowest = kInf;
   for (const Complex& p : out.closed_loop_poles) fastest = std::max(fastest, std::abs(p));
@@ -339,25 +344,17 @@ void time_indices(const ClosedLoopTransfer& cl, const std::vector<Complex>& visi
     out.sample_time = out.horizon / static_cast<double>(o.max_samples);
   }
   std::vector<core::TransferFunction> tfs{cl.motor_tracking, cl.effort};
-  if (load) {
-    tfs.push_back(*cl.load_tracking);
-    tfs.push_back(*cl.load_from_load_torque);
-  }
+  if (tracking) tfs.push_back(*cl.load_tracking);
+  if (load) tfs.push_back(*cl.load_from_load_torque);
   std::vector<StepAccumulator> acc;
   for (const core::TransferFunction& g : tfs) acc.emplace_back(g.dc_gain(), o.settling_band);
   simulate_steps(tfs, out.sample_time, samples, acc);
   out.overshoot_motor = acc[0].overshoot();
   out.settling_time_motor = acc[0].settling_time(out.sample_time);
   out.peak_torque_step = acc[1].max_abs();
-  if (load) {
-    out.overshoot = acc[2].overshoot();
-    out.settling_time = acc[2].settling_time(out.sample_time);
-    out.itae_load_step = acc[3].itae();
-  } else {
-    out.overshoot = out.overshoot_motor;
-    out.settling_time = out.settling_time_motor;
-    out.itae_load_step = kNaN;
-  }
+  out.overshoot = tracking ? acc[2].overshoot() : out.overshoot_motor;
+  out.settling_time = tracking ? acc[2].settling_time(out.sample_time) : out.settling_time_motor;
+  out.itae_load_step = load ? acc[3].itae() : kNaN;
 }
 
 void mark_unstable(LoopIndices& out) {
@@ -449,7 +446,7 @@ LoopIndices analyse(const VelocityLoop& loop, const AnalysisOptions& options) {
   }
   const std::vector<double> grid = analysis_grid(options, out.closed_loop_poles);
   frequency_indices(loop, cl, grid, options, out);
-  time_indices(cl, visible, loop.has_load(), options, out);
+  time_indices(cl, visible, options, out);
   return out;
 }
 

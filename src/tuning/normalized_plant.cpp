@@ -206,6 +206,22 @@ std::optional<core::TransferFunction> NormalizedPlant::load() const {
                                 Polynomial{1.0, a} * Polynomial{1.0, 2.0 * zeta_p * r, r * r});
 }
 
+std::optional<core::TransferFunction> NormalizedPlant::load_estimate() const {
+  if (!higher_modes.empty() && !chain_load) return std::nullopt;
+  NormalizedPlant first = *this;
+  first.higher_modes.clear();
+  const std::optional<core::TransferFunction> two_mass = first.load();
+  if (!two_mass) return std::nullopt;
+  Polynomial num = two_mass->num();
+  Polynomial den = two_mass->den();
+  for (const fit::Mode& m : higher_modes) {
+    const double wp = m.resonance.omega_rad_s, wz = m.antiresonance.omega_rad_s;
+    num = num * Polynomial{2.0 * m.antiresonance.zeta * wp * wp / wz, wp * wp};
+    den = den * quadratic_polynomial(m.resonance);
+  }
+  return core::TransferFunction(num, den);
+}
+
 std::complex<double> NormalizedPlant::measured_response(double omega) const {
   const Complex s(0.0, omega);
   Complex p = (s * s + 2.0 * zeta_z * s + 1.0) / ((s + a) * (s * s + 2.0 * zeta_p * r * s + r * r));

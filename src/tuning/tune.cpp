@@ -69,10 +69,10 @@ void validate(const TuneOptions& o) {
 }
 
 /// What the automatic searches maximize: the load tracking bandwidth where the plant has a load
-/// side (a two-mass realization, as VelocityLoop::has_load()), else the motor's.
+/// side (NormalizedPlant::load_estimate(), as VelocityLoop::has_load_tracking()), else the motor's.
 std::string largest_bandwidth(const NormalizedPlant& plant) {
-  const bool load = plant.higher_modes.empty() && two_mass_realization(plant).has_value();
-  return load ? "largest load bandwidth" : "largest motor bandwidth (no load side)";
+  if (!plant.load_estimate()) return "largest motor bandwidth (no load side)";
+  return plant.higher_modes.empty() ? "largest load bandwidth" : "largest load bandwidth (load through the chain)";
 }
 
 /// A note when the first mode's two-mass realization is not passive: its load side (the load
@@ -159,7 +159,7 @@ struct SpecCheck {
     c.stable = loop.stable();
     if (!c.stable) return c;
     c.peak_s = core::peak_on_grid([&](double w) { return loop.sensitivity(w); }, grid, 1e-4).value;
-    const bool load = loop.has_load();
+    const bool load = loop.has_load_tracking();
     const auto tracking = [&](double w) { return load ? loop.load_tracking(w) : loop.motor_tracking(w); };
     c.peak_tracking = core::peak_on_grid(tracking, grid, 1e-4).value;
     c.bandwidth = core::bandwidth(tracking, bandwidth_grid).value_or(0.0);
@@ -753,6 +753,7 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   validate(options);
   TuneResult result;
   result.plant = normalize(model, options.hf);
+  result.plant.chain_load = options.chain_load;
   const NormalizedPlant& plant = result.plant;
   result.advice = advise(plant.r, options.zeta_star);
   if (plant.r < kRatioForPassiveMethods) {
@@ -787,7 +788,8 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
     c.notes.push_back(fmt::format("least closed-loop damping {:.3g} is below --min-damping {:.3g}: the given design "
                                   "parameter was kept (the automatic search enforces the floor)",
                                   c.predicted.min_damping, *options.min_damping));
-  if (!plant.higher_modes.empty() && !options.min_damping && c.predicted.min_damping < kLowDampingNote)
+  if (!plant.higher_modes.empty() && !plant.load_estimate() && !options.min_damping &&
+      c.predicted.min_damping < kLowDampingNote)
     c.notes.push_back(fmt::format(
         "least closed-loop damping {:.3g}: without a load side the search maximizes the motor bandwidth and may "
         "leave a closed-loop mode (near an antiresonance or a higher resonance) ringing in the load or the frame "

@@ -137,6 +137,13 @@ VelocityLoop::VelocityLoop(const NormalizedPlant& plant, ControllerTf controller
       load_inertia_ = m->load_inertia;
     }
   }
+  has_load_tracking_ = has_load_;
+  if (!p.higher_modes.empty()) {
+    if (const std::optional<TransferFunction> estimate = p.load_estimate()) {
+      has_load_tracking_ = true;
+      load_num_ = (plant_den_.leading() / estimate->den().leading()) * estimate->num();
+    }
+  }
   const TransferFunction pade = pade_delay(delay_, pade_order_);
   characteristic_ = characteristic(pade.num(), pade.den());
 }
@@ -205,7 +212,7 @@ Complex VelocityLoop::effort(double omega) const noexcept {
 }
 
 Complex VelocityLoop::load_tracking(double omega) const noexcept {
-  if (!has_load_) return {kNaN, kNaN};
+  if (!has_load_tracking_) return {kNaN, kNaN};
   const Values v = values(omega);
   return v.nr * v.na * v.df * load_num_(Complex(0.0, omega)) / v.delta;
 }
@@ -242,12 +249,12 @@ VelocityLoop::Responses VelocityLoop::responses(double omega) const noexcept {
   r.complementary = open / v.delta;
   r.motor_tracking = v.nr * v.na * v.df * v.np / v.delta;
   r.effort = v.nr * v.da * v.df * v.dp / v.delta;
+  r.load_tracking = has_load_tracking_ ? v.nr * v.na * v.df * load_num_(s) / v.delta : Complex(kNaN, kNaN);
   if (!has_load_) {
-    r.load_tracking = r.motor_from_load_torque = r.load_from_load_torque = r.open_loop_load_from_load_torque = {kNaN, kNaN};
+    r.motor_from_load_torque = r.load_from_load_torque = r.open_loop_load_from_load_torque = {kNaN, kNaN};
     return r;
   }
   const Complex load_dist = load_dist_num_(s);
-  r.load_tracking = v.nr * v.na * v.df * load_num_(s) / v.delta;
   r.motor_from_load_torque = motor_dist_num_(s) * v.dc * v.da * v.df / v.delta;
   r.load_from_load_torque = (load_dist * v.dc * v.da * v.df - s * v.nc * v.na * v.nf / load_inertia_) / v.delta;
   r.open_loop_load_from_load_torque = load_dist / v.dp;
@@ -272,8 +279,8 @@ ClosedLoopTransfer VelocityLoop::rational(const Polynomial& delay_num, const Pol
                         std::nullopt,
                         std::nullopt,
                         std::nullopt};
+  if (has_load_tracking_) cl.load_tracking = TransferFunction(nr * na * fb_den_ * load_num_, delta);
   if (has_load_) {
-    cl.load_tracking = TransferFunction(nr * na * fb_den_ * load_num_, delta);
     cl.motor_from_load_torque = TransferFunction(motor_dist_num_ * dc * da * fb_den_, delta);
     cl.load_from_load_torque = TransferFunction(
         load_dist_num_ * dc * da * fb_den_ - (1.0 / load_inertia_) * (Polynomial{1.0, 0.0} * nc * na * fb_num_), delta);

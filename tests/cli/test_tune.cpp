@@ -137,6 +137,14 @@ TEST_F(Cli, CompareOnTheTestBedEstimatesTheLoadSide) {
   EXPECT_NE(t.out.find("step of 1: overshoot"), std::string::npos) << t.out;
   EXPECT_NE(t.out.find("load step: not simulated (a transfer-function plant has no load-torque input)"),
             std::string::npos) << t.out;
+  // Configuration 1 has a second mode: a load side only when it is declared part of the chain.
+  Result one = run("tune testbed-1 --structure pi --ms 2.5 --mt 2.5 -o one.json");
+  ASSERT_EQ(one.status, 0) << one.err;
+  EXPECT_NE(one.out.find("largest motor bandwidth (no load side)"), std::string::npos) << one.out;
+  one = run("tune testbed-1 --structure pi --ms 2.5 --mt 2.5 --load-side chain -o chain.json");
+  ASSERT_EQ(one.status, 0) << one.err;
+  EXPECT_NE(one.out.find("largest load bandwidth (load through the chain)"), std::string::npos) << one.out;
+  EXPECT_EQ(run("tune testbed-1 --load-side frame -o bad.json").status, 2);
 }
 
 TEST_F(Cli, SimulateTheFrameSequence) {

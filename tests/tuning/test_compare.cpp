@@ -135,6 +135,49 @@ TEST(CompareStructures, TestBedTwoHinfAgainstPiAsInTheDissertation) {
   EXPECT_LT(h.peak_load_disturbance, p.peak_load_disturbance);
 }
 
+/// Catalog A6 configuration 1 (eq. 8.13, E37): K = 544.6, τ1 = 0.16, τ2 = 0.0038 s, modes
+/// (35.3, 0.19)/(70.8, 0.02) and (114.6, 0.11)/(260.1, 0.005) rad/s (r = 2.0).
+fit::PlantModel test_bed_1() {
+  fit::PlantModel m = test_bed_2();
+  m.rigid_pole_rad_s = 0.16;
+  const double lag = 1.0 / 0.0038;
+  m.lag_pole_rad_s = lag;
+  m.gain = 544.6 * lag;
+  m.modes = {{{35.3, 0.19}, {70.8, 0.02}}, {{114.6, 0.11}, {260.1, 0.005}}};
+  return m;
+}
+
+TEST(CompareStructures, TestBedOneHasALoadSideOnlyAsAChain) {
+  // A6 configuration 1: two modes. Without --load-side chain the tuner cannot know where the load
+  // sits and maximizes the motor bandwidth (no load numbers); declared a drive-train chain, PI (on
+  // the first mode, as A6) and H∞ (on the full model) are compared on the estimated load. Measured:
+  // the H∞ reaches ×2.7 the PI's load bandwidth, but with a larger load overshoot (68 % against
+  // 19 %): the dissertation's "similar bandwidth for all three" is not what the tuner finds at Ms =
+  // Mt = 2.5 (documented in docs/controller-tuning-study.md).
+  TuneOptions o;
+  o.ms = o.mt = 2.5;
+  o.hf.delay_s = 0.5 * 0.0005;
+  const std::vector<StructureComparison> motor_only = compare_structures(test_bed_1(), o, {Structure::kPi});
+  ASSERT_TRUE(motor_only.front().result.has_value());
+  EXPECT_TRUE(std::isnan(motor_only.front().result->controller.predicted.bandwidth_load));
+  o.chain_load = true;
+  const std::vector<StructureComparison> c = compare_structures(test_bed_1(), o, {Structure::kPi, Structure::kHinf});
+  const StructureComparison& pi = entry(c, Structure::kPi);
+  const StructureComparison& hinf = entry(c, Structure::kHinf);
+  ASSERT_TRUE(pi.result && hinf.result) << pi.failure << hinf.failure;
+  const LoopIndices& p = pi.result->controller.predicted;
+  const LoopIndices& h = hinf.result->controller.predicted;
+  for (const LoopIndices* i : {&p, &h}) {
+    EXPECT_TRUE(std::isfinite(i->bandwidth_load));
+    EXPECT_LE(i->peak_tl, 2.5 * (1.0 + 1e-3));
+    EXPECT_LE(i->peak_s, 2.5 * (1.0 + 1e-3));
+    EXPECT_TRUE(std::isnan(i->itae_load_step));  // no load-torque functions for a chain estimate
+  }
+  EXPECT_NE(pi.result->controller.design.omega_star_source.find("load through the chain"), std::string::npos);
+  EXPECT_GT(h.bandwidth_load, 2.0 * p.bandwidth_load);
+  EXPECT_GT(h.overshoot, 2.0 * p.overshoot);
+}
+
 TEST(CompareStructures, TheLqgDesignsOnANonPassiveRealization) {
   // The LQG's design model is the first mode's two-mass realization; for the test bed it has
   // negative motor friction (bm = −6.45 normalized), which the LQG used to refuse. It is an exact

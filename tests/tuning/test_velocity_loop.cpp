@@ -160,11 +160,71 @@ TEST(VelocityLoop, E26ClosedLoopPoles) {
   EXPECT_FALSE(VelocityLoop(plant_with_hf(), {400.0, 10.0}).stable());
 }
 
+/// An undamped three-mass chain J1–k1–J2–k2–J3, torque on J1 (the motor), load J3.
+struct Chain {
+  Eigen::Matrix3d m = Eigen::Vector3d(1.0, 2.0, 0.5).asDiagonal();
+  double k1 = 10.0, k2 = 40.0;
+  [[nodiscard]] Eigen::Matrix3d stiffness() const {
+    Eigen::Matrix3d k;
+    k << k1, -k1, 0.0, -k1, k1 + k2, -k2, 0.0, -k2, k2;
+    return k;
+  }
+  /// Velocities of the three masses per motor torque at s = jω.
+  [[nodiscard]] Eigen::Vector3cd velocities(double w) const {
+    const Complex s(0.0, w);
+    const Eigen::Matrix3cd a = m.cast<Complex>() * s * s + stiffness().cast<Complex>();
+    return s * a.inverse().col(0);
+  }
+  /// Resonances (the nonzero eigenfrequencies) and antiresonances (the chain with the motor
+  /// clamped), ascending [rad/s].
+  [[nodiscard]] std::pair<Eigen::Vector2d, Eigen::Vector2d> frequencies() const {
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix3d> all(stiffness(), m);
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d> clamped(stiffness().bottomRightCorner<2, 2>(),
+                                                                      m.bottomRightCorner<2, 2>());
+    return {all.eigenvalues().tail<2>().cwiseSqrt(), clamped.eigenvalues().cwiseSqrt()};
+  }
+};
+
+TEST(VelocityLoop, ChainLoadEstimateIsExactForAnUndampedChain) {
+  // Reference: the chain's equations of motion solved at s = jω. Undamped, the load follows the
+  // motor as ωl/ωm = N(0)/N(s) with N the clamped-motor polynomial, which is what the estimate's
+  // per-mode couplings multiply out to; the motor model itself is the chain's exact motor response.
+  const Chain chain;
+  const auto [poles, zeros] = chain.frequencies();
+  fit::PlantModel model;
+  model.rigid = fit::RigidKind::kIntegrator;
+  model.gain = 1.0;  // 1/J1
+  model.modes = {{{zeros(0), 0.0}, {poles(0), 0.0}}, {{zeros(1), 0.0}, {poles(1), 0.0}}};
+  NormalizedPlant plant = normalize(model);
+  EXPECT_FALSE(plant.load_estimate().has_value());  // higher modes, not declared a chain
+  plant.chain_load = true;
+  const std::optional<core::TransferFunction> load = plant.load_estimate();
+  ASSERT_TRUE(load.has_value());
+  const core::TransferFunction motor = plant.motor(true);
+  for (double w : {0.05, 0.3, 0.7, 1.4, 2.5, 4.0, 9.0}) {
+    const Eigen::Vector3cd v = chain.velocities(w * plant.omega_z);
+    EXPECT_LT(rel(load->frequency_response(w) / motor.frequency_response(w), v(2) / v(0)), 1e-9) << w;
+  }
+  // The loop's load tracking is its motor tracking through the same ratio (block diagram).
+  const VelocityLoop loop(plant, {2.0, 0.5});
+  EXPECT_TRUE(loop.has_load_tracking());
+  EXPECT_FALSE(loop.has_load());
+  EXPECT_TRUE(std::isnan(loop.load_from_load_torque(1.0).real()));
+  for (double w : {0.3, 1.4, 4.0}) {
+    const Complex ratio = load->frequency_response(w) / motor.frequency_response(w);
+    EXPECT_LT(rel(loop.load_tracking(w), loop.motor_tracking(w) * ratio), 1e-10) << w;
+    EXPECT_LT(rel(loop.responses(w).load_tracking, loop.load_tracking(w)), 1e-12) << w;
+  }
+  ASSERT_TRUE(loop.closed_loop().load_tracking.has_value());
+  EXPECT_LT(rel(loop.closed_loop().load_tracking->frequency_response(0.7), loop.load_tracking(0.7)), 1e-6);
+}
+
 TEST(VelocityLoop, HigherModesHaveNoLoadSide) {
   NormalizedPlant plant = normalized_two_mass(2.0, 0.02);
   plant.higher_modes.push_back({{6.0, 0.01}, {12.0, 0.02}});
   const VelocityLoop full(plant, {2.0, 0.5});
   EXPECT_FALSE(full.has_load());
+  EXPECT_FALSE(full.has_load_tracking());
   EXPECT_TRUE(std::isnan(full.load_tracking(1.0).real()));
   EXPECT_FALSE(full.closed_loop().load_tracking.has_value());
   EXPECT_EQ(full.closed_loop().characteristic.degree(), 6);

@@ -69,6 +69,11 @@ struct NormalizedPlant {
   std::vector<fit::Mode> higher_modes;
   fit::OutputKind output = fit::OutputKind::kVelocity;  ///< what the fitted model measured
   HfDynamics hf;  ///< known HF dynamics in normalized time
+  /// The higher modes lie in the drive train between motor and load (a chain of inertias: a test
+  /// bed, a ball screw with a coupling), so load_estimate() reads them as couplings. False (the
+  /// default): where the higher modes sit is unknown (a frame, a machine structure) and a plant
+  /// with higher modes has no load side.
+  bool chain_load = false;
 
   /// Motor velocity per motor torque ωm/Tm in normalized units. Without higher modes this is the
   /// design model Pm above. With them, each higher mode enters as the unit-DC-gain factor
@@ -80,6 +85,14 @@ struct NormalizedPlant {
   /// (an estimate when that is not passive). std::nullopt when there are higher modes or no
   /// two-mass realization exists.
   [[nodiscard]] std::optional<core::TransferFunction> load() const;
+  /// Load velocity per motor torque ωl/Tm with the higher modes, over the denominator of
+  /// motor(true): load() without higher modes; with them and `chain_load`, load() times, for each
+  /// higher mode, the unit-DC-gain factor ωi²(2ζzi s/ωzi + 1)/(s² + 2ζi ωi s + ωi²), which reads
+  /// the mode's antiresonance as a coupling toward the load with all its damping in the coupling
+  /// (the two-mass shaft relation ωl/ωm = (2ζz ωz s + ωz²)/(s² + 2ζz ωz s + ωz²) applied per mode).
+  /// An estimate: a motor-side fit does not say how the chain's modes share the load. std::nullopt
+  /// when the first mode has no two-mass realization, or with higher modes and !chain_load.
+  [[nodiscard]] std::optional<core::TransferFunction> load_estimate() const;
   /// The measured output per torque at normalized frequency ω, with higher modes and HF
   /// dynamics: motor(true)(jω) · hf.response(ω), times 1/(jω) for a position output. The
   /// physical response is this divided by Im·ωz (velocity) or Im·ωz² (position) at ω = ω_phys/ωz.

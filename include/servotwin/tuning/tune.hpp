@@ -54,6 +54,10 @@ struct TuneOptions {
   /// tracking peak is the motor's, and the loop may leave a pole near an antiresonance barely
   /// damped (the load or the frame rings while the motor stands still): this asks for damping.
   std::optional<double> min_damping;
+  /// The plant's higher modes lie in the drive train between motor and load
+  /// (NormalizedPlant::chain_load): the searches then maximize the estimated load bandwidth through
+  /// them instead of the motor's.
+  bool chain_load = false;
   /// Multiplicative uncertainty weight W2(s) in physical s [rad/s]: when given, automatic ω* also
   /// requires robust performance sup(|S|/Ms + |W2 T|) < 1 and the result reports RS/NP/RP.
   std::optional<core::TransferFunction> w2;

@@ -16,8 +16,9 @@
 ///   L = C·F·A·Pm,  S = 1/(1 + L),  T = L/(1 + L).
 ///
 /// Load-side functions exist only for a plant with a two-mass realization
-/// (two_mass_realization(); an estimate when it is not passive); with higher modes they are
-/// std::nullopt.
+/// (two_mass_realization(); an estimate when it is not passive); with higher modes only the load
+/// tracking of a drive-train chain exists (NormalizedPlant::chain_load, load_estimate()) and the
+/// load-torque functions are std::nullopt.
 
 #include <complex>
 #include <optional>
@@ -78,7 +79,7 @@ struct ClosedLoopTransfer {
 class VelocityLoop {
  public:
   /// `with_hf`: include plant.hf (evaluation) or design on the bare model (false). `with_higher_modes`:
-  /// use NormalizedPlant::motor(true) (load-side functions are then unavailable when modes exist).
+  /// use NormalizedPlant::motor(true) (with modes, only the load tracking of a chain exists).
   /// `pade_order` is used by closed_loop() only. std::invalid_argument unless plant.r > 1 (a
   /// NormalizedPlant from normalize() always has r > 1.05).
   VelocityLoop(const NormalizedPlant& plant, const PidGains& gains, bool with_hf = true,
@@ -94,7 +95,11 @@ class VelocityLoop {
   [[nodiscard]] const core::Polynomial& plant_den() const noexcept { return plant_den_; }
   /// |C(j∞)|: the controller's high-frequency gain (the ratio of leading coefficients).
   [[nodiscard]] double controller_hf_limit() const noexcept;
+  /// The load side of the two-mass realization: load tracking and the load-torque functions.
   [[nodiscard]] bool has_load() const noexcept { return has_load_; }
+  /// The load tracking ωl/ω* exists: has_load(), or a plant whose higher modes are in the drive
+  /// train (NormalizedPlant::chain_load and load_estimate(); the load-torque functions stay NaN).
+  [[nodiscard]] bool has_load_tracking() const noexcept { return has_load_tracking_; }
 
   /// Frequency functions at s = jω (normalized ω >= 0), delay exact.
   [[nodiscard]] std::complex<double> controller(double omega) const noexcept;     ///< C(jω)
@@ -104,7 +109,7 @@ class VelocityLoop {
   [[nodiscard]] std::complex<double> complementary(double omega) const noexcept;  ///< T
   [[nodiscard]] std::complex<double> motor_tracking(double omega) const noexcept; ///< ωm/ω*
   [[nodiscard]] std::complex<double> effort(double omega) const noexcept;         ///< u/ω*
-  /// ωl/ω*, ωm/Tl and ωl/Tl; NaN when !has_load().
+  /// ωl/ω* (NaN when !has_load_tracking()), ωm/Tl and ωl/Tl (NaN when !has_load()).
   [[nodiscard]] std::complex<double> load_tracking(double omega) const noexcept;
   [[nodiscard]] std::complex<double> motor_from_load_torque(double omega) const noexcept;
   [[nodiscard]] std::complex<double> load_from_load_torque(double omega) const noexcept;
@@ -112,7 +117,8 @@ class VelocityLoop {
   [[nodiscard]] std::complex<double> open_loop_load_from_load_torque(double omega) const noexcept;
 
   /// Every function above at one frequency from one evaluation of the block polynomials (the
-  /// analyses' grid pass). Load-side members are NaN when !has_load().
+  /// analyses' grid pass). Load-side members are NaN when !has_load() (load_tracking: when
+  /// !has_load_tracking()).
   struct Responses {
     std::complex<double> loop_gain, sensitivity, complementary, motor_tracking, effort;
     std::complex<double> load_tracking, motor_from_load_torque, load_from_load_torque, open_loop_load_from_load_torque;
@@ -141,7 +147,8 @@ class VelocityLoop {
   core::Polynomial fb_num_{1.0}, fb_den_{1.0};    // feedback filter
   double delay_ = 0.0;
   bool has_load_ = false;
-  // Two-mass numerators over plant_den: ωl/Tm, ωm/Tl, ωl/Tl; load_inertia Il (normalized).
+  bool has_load_tracking_ = false;
+  // Two-mass numerators over plant_den: ωl/Tm (with higher modes in the chain: of load_estimate()), ωm/Tl, ωl/Tl; load_inertia Il (normalized).
   core::Polynomial load_num_, motor_dist_num_, load_dist_num_;
   double load_inertia_ = 1.0;
   int pade_order_ = 6;
