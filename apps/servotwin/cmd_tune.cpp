@@ -37,7 +37,7 @@ struct TuneArgs {
   std::optional<int> controller_order;
   bool raw_motor_velocity = false;
   std::optional<double> measurement_noise;
-  double target_r = 2.0;
+  std::string target_r = "2";
   std::optional<double> tau;
   bool allow_negative_kd = false;
   TuneSpecArgs spec;
@@ -45,16 +45,6 @@ struct TuneArgs {
   std::string out;
   std::string report;
 };
-
-/// "auto" (std::nullopt) or a number >= 0 (> 0 unless `zero_ok`).
-std::optional<double> parse_auto(const std::string& text, const char* flag, bool zero_ok, const char* what) {
-  if (text == "auto") return std::nullopt;
-  const std::optional<double> v = parse_number(text);
-  if (!v || *v < 0.0 || (!zero_ok && *v == 0.0)) {
-    throw core::InputError(core::at_field(flag), fmt::format("expected \"auto\" or {}, got \"{}\"", what, text));
-  }
-  return v;
-}
 
 tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
   tuning::TuneOptions o;
@@ -73,7 +63,7 @@ tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
     o.lqg.measurement_noise = *a.measurement_noise;  // the user's V is kept, not raised
     o.raise_measurement_noise = false;
   }
-  o.target_r = a.target_r;
+  o.target_r = parse_auto(a.target_r, "--target-r", false, "a resonance ratio > 1");
   o.tau = a.tau;
   o.allow_negative_kd = a.allow_negative_kd;
   o.setpoint_weight = a.setpoint_weight;
@@ -313,7 +303,8 @@ void register_tune(CLI::App& app, Action& selected) {
   cmd->add_option("--controller-order", a->controller_order,
                   "H-infinity: reduce the controller to this many states by balanced truncation of its stable part "
                   "(the integrator and unstable poles are kept; default: its minimal realization)");
-  cmd->add_option("--target-r", a->target_r, "PID: virtual resonance ratio r-bar the derivative gain creates")
+  cmd->add_option("--target-r", a->target_r, "PID: virtual resonance ratio r-bar the derivative gain creates, or auto (the largest bandwidth "
+                  "between 2 and 0.9 r: for lags or delays that leave no phase for the derivative)")
       ->capture_default_str();
   cmd->add_option("--tau", a->tau, "PID: derivative filter time constant [s] (default: 1/max(r, 5 omega*) in omega_z units)");
   cmd->add_flag("--allow-negative-kd", a->allow_negative_kd, "PID: accept a negative Kd (r < r-bar: acceleration feedback)");

@@ -28,7 +28,7 @@ namespace {
 struct TuneCompareArgs {
   std::string plant;
   std::string structures = "pi,pid,lqg,hinf";
-  double target_r = 2.0;
+  std::string target_r = "2";
   TuneSpecArgs spec;
   std::string report;
 };
@@ -143,7 +143,7 @@ int run_tune_compare(const TuneCompareArgs& a, const GlobalOptions& global) {
   const TunePlant plant = load_tune_plant(a.plant);
   const auto report_file = open_report(a.report, global);
   tuning::TuneOptions options;
-  options.target_r = a.target_r;
+  options.target_r = parse_auto(a.target_r, "--target-r", false, "a resonance ratio > 1");
   apply_spec(a.spec, plant, options);
   const std::vector<tuning::Structure> structures = parse_structures(a.structures);
   const std::vector<tuning::StructureComparison> comparison = tuning::compare_structures(plant.model, options, structures);
@@ -171,7 +171,8 @@ void add_tune_compare(CLI::App& tune, Action& selected) {
       ->required();
   cmd->add_option("--structures", a->structures, "Comma-separated structures to compare (pi, pid, lqg, hinf)")
       ->capture_default_str();
-  cmd->add_option("--target-r", a->target_r, "PID: virtual resonance ratio r-bar (C7.15 uses 2)")->capture_default_str();
+  cmd->add_option("--target-r", a->target_r, "PID: virtual resonance ratio r-bar (C7.15 uses 2), or auto (the largest bandwidth between 2 "
+                  "and 0.9 r)")->capture_default_str();
   add_spec_options(*cmd, a->spec);
   add_report_option(*cmd, a->report);
   set_examples(*cmd,

@@ -88,6 +88,15 @@ TunePlant load_tune_plant(const std::string& name_or_path) {
   return from_description(io::load_plant(name_or_path), name_or_path);
 }
 
+std::optional<double> parse_auto(const std::string& text, const char* flag, bool zero_ok, const char* what) {
+  if (text == "auto") return std::nullopt;
+  const std::optional<double> v = parse_number(text);
+  if (!v || *v < 0.0 || (!zero_ok && *v == 0.0)) {
+    throw core::InputError(core::at_field(flag), fmt::format("expected \"auto\" or {}, got \"{}\"", what, text));
+  }
+  return v;
+}
+
 std::optional<double> parse_number(const std::string& text) {
   std::size_t used = 0;
   double v = 0.0;

@@ -33,6 +33,10 @@ TunePlant load_tune_plant(const std::string& name_or_path);
 /// The whole of `text` as a finite number, or std::nullopt.
 std::optional<double> parse_number(const std::string& text);
 
+/// "auto" (std::nullopt) or a number >= 0 (> 0 unless `zero_ok`) for option `flag`; core::InputError
+/// naming the flag and `what` was expected otherwise.
+std::optional<double> parse_auto(const std::string& text, const char* flag, bool zero_ok, const char* what);
+
 /// Parses a coefficient list "2.6, 0" or "2.6 0" (descending powers of s) for option `option`.
 core::Polynomial parse_coefficients(const std::string& text, const std::string& option);
 

@@ -326,7 +326,7 @@ bool near_any(const Complex& p, const std::vector<Complex>& roots) {
                      [&](const Complex& z) { return std::abs(p - z) <= kCancellationDistance * std::abs(p); });
 }
 
-double damping_of(const Complex& p) { return std::abs(p) > 0.0 ? -p.real() / std::abs(p) : 1.0; }
+double damping_of(const Complex& p) { return core::modal_info(p).zeta; }
 
 void time_indices(const ClosedLoopTransfer& cl, const std::vector<Complex>& visible, const AnalysisOptions& o,
                   LoopIndices& out) {
@@ -539,7 +539,7 @@ class IndexEvaluator {
       score.j1 = 0.0;
       return score;
     }
-    const std::vector<Complex> poles = loop.closed_loop().characteristic.roots();
+    const std::vector<Complex> poles = loop.characteristic_polynomial().roots();
     const std::vector<double> grid = analysis_grid(o_.analysis, poles);
     if (want_j2) score.j2 = j2(loop, grid);
     if (want_j1) best_wp(loop, g, grid, score);

@@ -23,6 +23,9 @@ using core::at_field;
 constexpr double kRatioForPassiveMethods = 1.3;  // C7.4: below it no PI/PID reaches a useful bandwidth
 // Below this least closed-loop damping a design on a modal model (no load side) gets a note.
 constexpr double kLowDampingNote = 0.1;
+constexpr double kDefaultTargetR = 2.0;       // C7.5/C7.15: the PID's virtual resonance ratio
+constexpr std::size_t kTargetRCandidates = 6;  // automatic r̄: 2 … 0.9 r, geometric
+constexpr double kTargetRFractionOfR = 0.9;    // the largest automatic r̄ (r̄ = r is no derivative at all)
 
 void require(bool ok, const char* flag, const std::string& message) {
   if (!ok) throw InputError(at_field(flag), message);
@@ -35,8 +38,9 @@ void validate(const TuneOptions& o) {
     require(std::isfinite(*o.omega_star) && *o.omega_star > 0.0, "--omega-star",
             fmt::format("expected omega*/omega_z > 0, got {}", *o.omega_star));
   }
-  require(std::isfinite(o.target_r) && o.target_r > 1.0, "--target-r",
-          fmt::format("expected a resonance ratio > 1, got {}", o.target_r));
+  if (o.target_r)
+    require(std::isfinite(*o.target_r) && *o.target_r > 1.0, "--target-r",
+            fmt::format("expected a resonance ratio > 1, got {}", *o.target_r));
   if (o.tau) require(std::isfinite(*o.tau) && *o.tau > 0.0, "--tau", fmt::format("expected a time > 0 s, got {}", *o.tau));
   require(std::isfinite(o.ms) && o.ms > 1.0, "--ms", fmt::format("expected a sensitivity peak limit > 1, got {}", o.ms));
   require(std::isfinite(o.mt) && o.mt >= 1.0, "--mt", fmt::format("expected a tracking peak limit >= 1, got {}", o.mt));
@@ -117,7 +121,7 @@ struct GainDesigner {
   [[nodiscard]] PidGains operator()(double omega_star, std::vector<std::string>* warnings = nullptr) const {
     PidGains g;
     if (options.structure == Structure::kPid) {
-      const PidDesign d = pid_design(plant, options.target_r, omega_star, options.zeta_star,
+      const PidDesign d = pid_design(plant, options.target_r.value_or(kDefaultTargetR), omega_star, options.zeta_star,
                                      tau_normalized(omega_star), options.allow_negative_kd);
       g = d.gains;
       if (warnings) warnings->insert(warnings->end(), d.warnings.begin(), d.warnings.end());
@@ -165,7 +169,7 @@ struct SpecCheck {
     c.bandwidth = core::bandwidth(tracking, bandwidth_grid).value_or(0.0);
     c.feasible = c.peak_s <= options.ms && c.peak_tracking <= options.mt;
     if (options.min_damping) {
-      c.min_damping = least_visible_damping(loop, loop.closed_loop().characteristic.roots());
+      c.min_damping = least_visible_damping(loop, loop.characteristic_polynomial().roots());
       c.feasible = c.feasible && c.min_damping >= *options.min_damping;
     }
     if (c.feasible && w2) c.feasible = robust(loop);
@@ -700,11 +704,59 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
   if (!result.advice.verdict.empty()) result.controller.notes.push_back(result.advice.verdict);
 }
 
+/// The bandwidth the automatic searches compare: the load's where there is one, else the motor's.
+double compared_bandwidth(const LoopIndices& i) {
+  return std::isfinite(i.bandwidth_load) ? i.bandwidth_load : i.bandwidth_motor;
+}
+
+void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecCheck& check);
+
+/// PID with an automatic r̄: tuned at r̄ = 2 and at r̄ toward 0.9 r (a smaller derivative gain),
+/// the largest bandwidth kept; the error of r̄ = 2 when none meets the spec.
+void tune_pid_automatic_ratio(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
+  const double r = result.plant.r;
+  std::vector<double> ratios{kDefaultTargetR};
+  const double top = kTargetRFractionOfR * r;
+  for (std::size_t k = 1; top > kDefaultTargetR && k < kTargetRCandidates; ++k)
+    ratios.push_back(kDefaultTargetR * std::pow(top / kDefaultTargetR, static_cast<double>(k) /
+                                                                        static_cast<double>(kTargetRCandidates - 1)));
+  std::optional<TuneResult> best;
+  double at_default = std::numeric_limits<double>::quiet_NaN();
+  for (const double ratio : ratios) {
+    TuneOptions o = options;
+    o.target_r = ratio;
+    TuneResult trial = result;
+    try {
+      tune_cascade(trial, o, check);
+    } catch (const InputError&) {
+      continue;  // no ω* meets the spec at this r̄
+    }
+    const double bandwidth = compared_bandwidth(trial.controller.predicted);
+    if (ratio == kDefaultTargetR) at_default = bandwidth;
+    if (!best || bandwidth > compared_bandwidth(best->controller.predicted)) best = std::move(trial);
+  }
+  if (!best) {
+    TuneOptions o = options;
+    o.target_r = kDefaultTargetR;
+    tune_cascade(result, o, check);  // throws the spec's error at r̄ = 2
+    return;
+  }
+  result = std::move(*best);
+  const double chosen = *result.controller.design.r_target;
+  result.controller.notes.push_back(fmt::format(
+      "r-bar chosen automatically: {:.3g} of {} tried between 2 and {:.3g} (largest bandwidth: {:.3g} Hz; r-bar = 2: {})",
+      chosen, ratios.size(), ratios.back(), result.plant.physical_frequency(compared_bandwidth(result.controller.predicted)) /
+                                                 (2.0 * std::numbers::pi),
+      std::isfinite(at_default) ? fmt::format("{:.3g} Hz", result.plant.physical_frequency(at_default) / (2.0 * std::numbers::pi))
+                                : std::string("no omega* meets the spec")));
+}
+
 /// The cascade path of tune() (pi, pid, pi+p): ω*, the gains, their analysis and robustness.
 void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
   const NormalizedPlant& plant = result.plant;
   const GainDesigner design{plant, options};
-  const double kd = options.structure == Structure::kPid ? virtual_inertia_kd(plant.r, options.target_r) : 0.0;
+  const double kd =
+      options.structure == Structure::kPid ? virtual_inertia_kd(plant.r, options.target_r.value_or(kDefaultTargetR)) : 0.0;
   result.range = admissible_range(plant, options.zeta_star, kd);
   if (result.range.empty()) {
     throw InputError(at_field("--zeta-star"),
@@ -714,7 +766,7 @@ void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecChec
   }
   Controller& c = result.controller;
   c.design.zeta_star = options.zeta_star;
-  if (options.structure == Structure::kPid) c.design.r_target = options.target_r;
+  if (options.structure == Structure::kPid) c.design.r_target = options.target_r.value_or(kDefaultTargetR);
 
   if (options.omega_star) {
     const double w = *options.omega_star;
@@ -779,6 +831,8 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
     tune_hinf(result, options, check);
   } else if (is_full_order(options.structure)) {
     tune_lqg(result, options, check);
+  } else if (options.structure == Structure::kPid && !options.target_r) {
+    tune_pid_automatic_ratio(result, options, check);
   } else {
     tune_cascade(result, options, check);
   }

@@ -234,7 +234,7 @@ std::vector<double> robustness_grid(const VelocityLoop& loop, const TransferFunc
   const auto add = [&](double w) {
     if (w > o.omega_min && w < o.omega_max) grid.push_back(w);
   };
-  for (const std::complex<double>& p : loop.closed_loop().characteristic.roots()) {
+  for (const std::complex<double>& p : loop.characteristic_polynomial().roots()) {
     const double m = std::abs(p);
     if (m > 0.0 && -p.real() / m < 0.5) add(std::abs(p.imag()));
   }

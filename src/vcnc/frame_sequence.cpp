@@ -107,11 +107,6 @@ FramePhase phase_metrics(const FrameSequence& run, const FrameSequenceSettings& 
   return p;
 }
 
-double damping_of(const std::complex<double>& p) {
-  const double m = std::abs(p);
-  return m > 0.0 ? -p.real() / m : 1.0;
-}
-
 /// Modal decomposition of the closed loop: its eigenvectors V and W = V^-1, and the equilibrium
 /// map -A^-1 B (A is Hurwitz once the loop is stable).
 struct Modes {
@@ -137,7 +132,7 @@ struct Modes {
       const Eigen::VectorXcd shape = cl.C.topRows(3).cast<std::complex<double>>() * v.col(i);
       FrameMode m;
       m.pole = poles(i);
-      m.damping = damping_of(poles(i));
+      m.damping = core::modal_info(poles(i)).zeta;
       m.rotor = 2.0 * std::abs(shape(0) * coordinate);
       m.load = 2.0 * std::abs(shape(1) * coordinate);
       m.stator = 2.0 * std::abs(shape(2) * coordinate);
@@ -189,7 +184,7 @@ FrameSequence simulate_frame_sequence(const machine::FlexibleFrame& frame, const
   out.min_damping = 1.0;
   std::string unstable;
   for (const auto& p : out.closed_loop_poles) {
-    out.min_damping = std::min(out.min_damping, damping_of(p));
+    out.min_damping = std::min(out.min_damping, core::modal_info(p).zeta);
     if (p.real() >= 0.0) unstable += fmt::format(" {:.4g}{:+.4g}j", p.real(), p.imag());
   }
   if (!unstable.empty()) throw std::domain_error("the closed loop on the flexible frame is unstable; poles:" + unstable);

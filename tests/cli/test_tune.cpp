@@ -145,6 +145,14 @@ TEST_F(Cli, CompareOnTheTestBedEstimatesTheLoadSide) {
   ASSERT_EQ(one.status, 0) << one.err;
   EXPECT_NE(one.out.find("largest load bandwidth (load through the chain)"), std::string::npos) << one.out;
   EXPECT_EQ(run("tune testbed-1 --load-side frame -o bad.json").status, 2);
+  // The PID's r-bar = 2 has no phase to work with behind the test bed's lag: auto searches r-bar.
+  const Result pid = run("tune testbed-2 --structure pid --target-r auto --ms 2.5 --mt 2.5 -o pid.json");
+  ASSERT_EQ(pid.status, 0) << pid.err;
+  EXPECT_NE(pid.out.find("note: r-bar chosen automatically"), std::string::npos) << pid.out;
+  const Result bad = run("tune testbed-2 --structure pid --target-r two -o pid2.json");
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.err.find("--target-r"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("expected \"auto\" or a resonance ratio > 1"), std::string::npos) << bad.err;
 }
 
 TEST_F(Cli, SimulateTheFrameSequence) {

@@ -215,6 +215,9 @@ TEST(VelocityLoop, ChainLoadEstimateIsExactForAnUndampedChain) {
     EXPECT_LT(rel(loop.load_tracking(w), loop.motor_tracking(w) * ratio), 1e-10) << w;
     EXPECT_LT(rel(loop.responses(w).load_tracking, loop.load_tracking(w)), 1e-12) << w;
   }
+  EXPECT_EQ(loop.characteristic_polynomial().coefficients().size(), loop.closed_loop().characteristic.coefficients().size());
+  for (std::size_t i = 0; i < loop.characteristic_polynomial().coefficients().size(); ++i)
+    EXPECT_EQ(loop.characteristic_polynomial().coefficients()[i], loop.closed_loop().characteristic.coefficients()[i]);
   ASSERT_TRUE(loop.closed_loop().load_tracking.has_value());
   EXPECT_LT(rel(loop.closed_loop().load_tracking->frequency_response(0.7), loop.load_tracking(0.7)), 1e-6);
 }

@@ -44,7 +44,10 @@ struct TuneOptions {
   Structure structure = Structure::kPi;
   double zeta_star = 0.8;               ///< damping of the assigned pair (C7.3)
   std::optional<double> omega_star;     ///< ω*/ωz; std::nullopt: automatic (J1 under Ms, Mt)
-  double target_r = 2.0;                ///< PID: the virtual resonance ratio r̄ (C7.5)
+  /// PID: the virtual resonance ratio r̄ (C7.5; C7.15 uses 2). std::nullopt: automatic, the
+  /// largest bandwidth over r̄ from 2 toward r (a lag or delay can leave no phase for the
+  /// derivative gain that r̄ = 2 needs on a high-r plant).
+  std::optional<double> target_r = 2.0;
   std::optional<double> tau;            ///< PID derivative filter [s]; default plan §1.5
   bool allow_negative_kd = false;       ///< PID with r < r̄ (acceleration feedback)
   double ms = 1.5;                      ///< ‖S‖∞ limit

@@ -130,6 +130,8 @@ class VelocityLoop {
 
   /// The rational closed loop (see ClosedLoopTransfer).
   [[nodiscard]] ClosedLoopTransfer closed_loop() const;
+  /// Δ(s) with the Padé delay: closed_loop().characteristic without building the numerators.
+  [[nodiscard]] const core::Polynomial& characteristic_polynomial() const noexcept { return characteristic_; }
   /// Routh test of Δ (with the Padé delay).
   [[nodiscard]] bool stable() const;
 
