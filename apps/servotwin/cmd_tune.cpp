@@ -297,7 +297,7 @@ void register_tune(CLI::App& app, Action& selected) {
   cmd->add_option("--modes", a->modes,
                   "H-infinity on a plant with higher modes (C7.16): active (design on the full model, damp every "
                   "mode), passive (design on it, cancel the higher modes: a notch) or first (design on mode 1, "
-                  "check on the full model)")
+                  "check on the full model); LQG: first designs on mode 1, the others on the extended model")
       ->check(CLI::IsMember({"active", "passive", "first"}))
       ->capture_default_str();
   cmd->add_option("--controller-order", a->controller_order,

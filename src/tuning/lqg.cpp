@@ -9,6 +9,7 @@
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/norms.hpp"
 #include "servotwin/core/riccati.hpp"
+#include "servotwin/core/transfer_function.hpp"
 
 namespace servotwin::tuning {
 
@@ -187,21 +188,67 @@ core::StateSpace two_mass_state_space(const FrictionTwoMass& p, bool position) {
 }
 
 LqgDesign velocity_lqg(const FrictionTwoMass& plant, double r, const VelocityLqgOptions& o) {
+  return velocity_lqg(plant, {}, r, o);
+}
+
+LqgDesign velocity_lqg(const FrictionTwoMass& plant, std::span<const fit::Mode> higher_modes, double r,
+                       const VelocityLqgOptions& o) {
   check_plant(plant, r);
   check_velocity_options(o);
-  const core::StateSpace p = two_mass_state_space(plant, false);
+  const core::StateSpace p = two_mass_state_space_with_modes(plant, higher_modes);
+  const Eigen::Index n = p.A.rows();
   const double rho = control_weight(o.kbw, r);
-  const Matrix w = velocity_process_noise(o);
+  // Q over [ωm, ωl, Ts, modes…, xi] and W over [ωm, ωl, Ts, modes…, Tl]: the modes get neither.
+  if (n < 3) throw std::logic_error("velocity_lqg: the design model lost its two-mass states");
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(n + 1);
+  q(1) = o.q_load_velocity;
+  q(2) = rho;
+  q(n) = o.q_integral;
+  Matrix w = Matrix::Zero(n + 1, n + 1);
+  w(0, 0) = o.noise_motor;
+  w(n, n) = o.noise_load_torque;
   const EstimatorModel e = estimator_model(p);
-  LqgDesign d = regulator_and_estimator(p, e, Eigen::Vector4d(0.0, o.q_load_velocity, rho, o.q_integral), rho, w,
-                                        Matrix::Constant(1, 1, o.measurement_noise));
-  // u = −K₁ x̂₁ − K₂ x̂₂ − K₃ x̂₃ − K₄ xi + kff ω* (K₁ on the measurement with raw_motor_velocity).
-  Eigen::RowVectorXd kx = Eigen::RowVectorXd::Zero(4);
-  kx.head(3) = d.regulator_gain.head(3);
+  LqgDesign d = regulator_and_estimator(p, e, q, rho, w, Matrix::Constant(1, 1, o.measurement_noise));
+  // u = −K x̂ − K_xi xi + kff ω* (K₁ on the measurement with raw_motor_velocity).
+  Eigen::RowVectorXd kx = Eigen::RowVectorXd::Zero(n + 1);
+  kx.head(n) = d.regulator_gain.head(n);
   double ky = 0.0;
   if (o.raw_motor_velocity) std::swap(ky, kx(0));
   finish(d, p, e, kx, ky, o.feedforward);
   return d;
+}
+
+core::StateSpace two_mass_state_space_with_modes(const FrictionTwoMass& plant, std::span<const fit::Mode> higher_modes) {
+  core::StateSpace out = two_mass_state_space(plant, false);
+  for (std::size_t i = 0; i < higher_modes.size(); ++i) {
+    const fit::Mode& m = higher_modes[i];
+    const std::string field = "higher_modes[" + std::to_string(i) + "]";
+    detail::require_positive(m.antiresonance.omega_rad_s, field + ".antiresonance.omega_rad_s", "a frequency");
+    detail::require_positive(m.resonance.omega_rad_s, field + ".resonance.omega_rad_s", "a frequency");
+    detail::require_non_negative(m.antiresonance.zeta, field + ".antiresonance.zeta", "a damping");
+    detail::require_non_negative(m.resonance.zeta, field + ".resonance.zeta", "a damping");
+    const double wz = m.antiresonance.omega_rad_s, wp = m.resonance.omega_rad_s;
+    const double hf = (wp * wp) / (wz * wz);  // 1/DC gain of the ratio of quadratics: unit DC gain overall
+    const core::StateSpace f = core::to_state_space(core::TransferFunction(
+        hf * core::Polynomial{1.0, 2.0 * m.antiresonance.zeta * wz, wz * wz},
+        core::Polynomial{1.0, 2.0 * m.resonance.zeta * wp, wp * wp}));
+    // The factor's output is the torque the model so far is driven with: Tm' = Cf xf + Df Tm.
+    const Eigen::Index n = out.A.rows(), k = f.A.rows();
+    core::StateSpace s;
+    s.A = Matrix::Zero(n + k, n + k);
+    s.A.topLeftCorner(n, n) = out.A;
+    s.A.block(0, n, n, k) = out.B.col(0) * f.C;
+    s.A.bottomRightCorner(k, k) = f.A;
+    s.B = Matrix::Zero(n + k, 2);
+    s.B.block(0, 0, n, 1) = out.B.col(0) * f.D(0, 0);
+    s.B.block(0, 1, n, 1) = out.B.col(1);
+    s.B.block(n, 0, k, 1) = f.B;
+    s.C = Matrix::Zero(out.C.rows(), n + k);
+    s.C.leftCols(n) = out.C;
+    s.D = out.D;
+    out = std::move(s);
+  }
+  return out;
 }
 
 LqgDesign load_side_lqg(const FrictionTwoMass& plant, double r, const VelocityLqgOptions& o) {

@@ -358,32 +358,42 @@ constexpr std::size_t kKbwPoints = 36;
 constexpr double kFeedforwardCap = 1e3;
 constexpr int kFeedforwardBisections = 40;
 
+/// The LQG's design model: the first mode's two-mass realization and the higher modes it is
+/// extended with (C7.16; none with --modes first).
+struct LqgModel {
+  FrictionTwoMass two_mass;
+  std::vector<fit::Mode> modes;
+};
+
 /// The C7.13 velocity LQG of the user's weights at one (kbw, kff), and its loop.
 struct LqgDesigner {
   const NormalizedPlant& plant;
-  FrictionTwoMass model;
+  const LqgModel& model;
   VelocityLqgOptions weights;
 
   [[nodiscard]] LqgDesign design(double kbw, double kff) const {
     VelocityLqgOptions w = weights;
     w.kbw = kbw;
     w.feedforward = kff;
-    return velocity_lqg(model, plant.r, w);
+    return velocity_lqg(model.two_mass, model.modes, plant.r, w);
   }
   [[nodiscard]] VelocityLoop loop(const LqgDesign& d) const { return VelocityLoop(plant, two_dof_form(d.compensator)); }
 };
 
-/// The first mode's two-mass realization with friction: the LQG's design model.
-FrictionTwoMass lqg_design_model(const NormalizedPlant& plant, Structure structure) {
+/// The LQG's design model: the first mode's two-mass realization with friction, extended by the
+/// higher modes unless the user asked for the first mode alone.
+LqgModel lqg_design_model(const NormalizedPlant& plant, const TuneOptions& options) {
   NormalizedPlant first = plant;
   first.higher_modes.clear();
   const std::optional<FrictionTwoMass> m = two_mass_realization(first);
   if (!m) {
     throw InputError(at_field("--structure"),
-                     to_string(structure) + " needs a two-mass realization, and this plant has none (its shaft "
-                     "damping would be negative); use --structure pi or pid");
+                     to_string(options.structure) + " needs a two-mass realization, and this plant has none (its "
+                     "shaft damping would be negative); use --structure pi or pid");
   }
-  return *m;
+  LqgModel model{*m, {}};
+  if (options.hinf_modes != ModeHandling::kFirstMode) model.modes = plant.higher_modes;
+  return model;
 }
 
 std::vector<double> kbw_candidates() {
@@ -452,7 +462,7 @@ std::optional<double> automatic_kbw(const LqgDesigner& lqg, const SpecCheck& che
 /// Automatic kbw; when nothing meets the spec with the options' measurement noise V, V is raised
 /// by decades (at most kMaxNoiseDecades, when allowed): C7.13's estimator has a fixed bandwidth
 /// (its weights do not scale with kbw), too high for a loop with delay, and a larger V slows it.
-void choose_kbw(const NormalizedPlant& plant, const FrictionTwoMass& model, const TuneOptions& options,
+void choose_kbw(const NormalizedPlant& plant, const LqgModel& model, const TuneOptions& options,
                 const SpecCheck& check, FullOrderSummary& f, TuneResult& result) {
   constexpr int kMaxNoiseDecades = 4;
   const double printed = f.weights.measurement_noise;
@@ -509,7 +519,7 @@ VelocityLoop finish_full_order(TuneResult& result, const TuneOptions& options, c
 /// The LQG path of tune(): kbw and kff, the compensator, its analysis and robustness.
 void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
   const NormalizedPlant& plant = result.plant;
-  const FrictionTwoMass model = lqg_design_model(plant, options.structure);
+  const LqgModel model = lqg_design_model(plant, options);
   Controller& c = result.controller;
   FullOrderSummary f;
   f.weights = options.lqg;
@@ -626,6 +636,9 @@ std::string higher_modes_note(const TuneOptions& o, const std::vector<fit::Mode>
     return fmt::format("designed on the full model: the controller cancels the {} higher mode(s) (a notch; "
                        "C7.16 passive): disturbances at the motor still excite them{}",
                        count, except);
+  if (is_full_order(o.structure) && o.hinf_modes != ModeHandling::kFirstMode)
+    return fmt::format("designed on the full model: the {} higher mode(s) extend the LQG's design model (C7.16), "
+                       "unweighted, so the regulator and the Kalman filter know them", count);
   return fmt::format("designed on the first mode; {} higher mode(s) are included in every index", count);
 }
 

@@ -176,6 +176,17 @@ TEST(CompareStructures, TestBedOneHasALoadSideOnlyAsAChain) {
   EXPECT_NE(pi.result->controller.design.omega_star_source.find("load through the chain"), std::string::npos);
   EXPECT_GT(h.bandwidth_load, 2.0 * p.bandwidth_load);
   EXPECT_GT(h.overshoot, 2.0 * p.overshoot);
+  // The LQG "on the full model" (A6): designed on the first mode it is destabilized by mode 2 and
+  // the lag at every kbw; with the model extended by mode 2 (C7.16) it designs, 7 states.
+  o.structure = Structure::kLqg;
+  o.hinf_modes = ModeHandling::kFirstMode;
+  test::expect_input_error([&] { (void)tune(test_bed_1(), o); }, "--structure", "kbw");
+  o.hinf_modes = ModeHandling::kActive;
+  const TuneResult lqg = tune(test_bed_1(), o);
+  EXPECT_TRUE(lqg.controller.predicted.closed_loop_stable);
+  EXPECT_EQ(lqg.controller.full_order->compensator.A.rows(), 7);
+  EXPECT_LE(lqg.controller.predicted.peak_tl, 2.5 * (1.0 + 1e-3));
+  EXPECT_LE(lqg.controller.predicted.peak_s, 2.5 * (1.0 + 1e-3));
 }
 
 TEST(CompareStructures, AnAutomaticTargetRatioRecoversThePidOnALaggedPlant) {

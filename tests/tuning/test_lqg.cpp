@@ -101,6 +101,42 @@ TEST(Lqg, VelocityDesignsMatchScipy) {
   }
 }
 
+TEST(Lqg, ModalDesignsMatchScipyAndTheFullPlant) {
+  // C7.16 "just extend the model": the higher modes in series with the motor torque. scipy builds
+  // the extended model in another basis (observer form), so the pole sets are compared; the loop
+  // closed around the full normalized plant (NormalizedPlant::motor(true), no HF dynamics) must
+  // have exactly the design's closed-loop poles, which holds only if the design model is the plant.
+  for (const auto& c : lqg_reference().at("modal")) {
+    const double r = c.at("r");
+    const double zz = c.at("zeta_z");
+    std::vector<fit::Mode> modes;
+    for (const auto& m : c.at("modes")) modes.push_back({{m.at(0).get<double>(), m.at(1).get<double>()},
+                                                         {m.at(2).get<double>(), m.at(3).get<double>()}});
+    VelocityLqgOptions o;
+    o.kbw = c.at("kbw");
+    const LqgDesign d = velocity_lqg(normalized(r, zz), modes, r, o);
+    SCOPED_TRACE("r = " + std::to_string(r) + ", modes " + std::to_string(modes.size()));
+    EXPECT_EQ(d.compensator.A.rows(), static_cast<Eigen::Index>(5 + 2 * modes.size()));
+    expect_same_roots(d.regulator_poles, roots_of(c.at("lqr_poles")), 1e-7, "regulator");
+    expect_same_roots(d.estimator_poles, roots_of(c.at("kf_poles")), 1e-7, "estimator");
+    expect_same_roots(d.controller_poles, roots_of(c.at("controller_poles")), 1e-6, "controller");
+    expect_same_roots(d.closed_loop_poles, roots_of(c.at("closed_loop_poles")), 1e-6, "closed loop");
+    NormalizedPlant plant = normalized_two_mass(r, zz);
+    plant.higher_modes = modes;
+    const core::StateSpace model = two_mass_state_space_with_modes(normalized(r, zz), modes);
+    const core::TransferFunction motor = plant.motor(true);
+    for (double w : {0.1, 0.9, 2.5, 7.0, 20.0}) {
+      const std::complex<double> s(0.0, w);
+      const Eigen::MatrixXcd resolvent = (s * Eigen::MatrixXcd::Identity(model.A.rows(), model.A.cols()) - model.A).inverse();
+      const std::complex<double> g = (model.C.row(0).cast<std::complex<double>>() * resolvent * model.B.col(0))(0, 0);
+      EXPECT_LT(std::abs(g / motor.frequency_response(w) - 1.0), 1e-9) << w;
+    }
+    const VelocityLoop loop(plant, two_dof_form(d.compensator), false, true);
+    expect_same_roots(loop.characteristic_polynomial().roots(), test::sorted_roots(d.closed_loop_poles), 1e-5,
+                      "loop around the full plant");
+  }
+}
+
 TEST(Lqg, ClosedLoopPolesAreRegulatorAndEstimatorPoles) {
   // Separation principle: with the estimate in the feedback the closed loop has exactly the
   // regulator's and the estimator's poles.

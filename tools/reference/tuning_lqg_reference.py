@@ -200,6 +200,74 @@ def load_side_case(r, zz, kbw, bm=0.0, bl=0.0):
     }
 
 
+def modal_case(r, zz, kbw, modes):
+    """C7.16's "extended model" velocity LQG: each higher mode (wz, zeta_z, wp, zeta_p) as the
+    unit-DC-gain factor hf (s^2 + 2 zeta_z wz s + wz^2)/(s^2 + 2 zeta_p wp s + wp^2), hf = wp^2/wz^2,
+    in series with the motor torque, realized here in observer form (hf + (c1 s + c0)/(s^2 + a1 s
+    + a0)), a basis other than servotwin's: the gains differ by the basis, the pole sets do not."""
+    ap, bu, bt, il, k, b = plant(r, zz, 0.0, 0.0)
+    a, bu_x, bt_x, c_x = ap, bu, bt, np.array([[1.0, 0.0, 0.0]])
+    for wz, zetaz, wp, zetap in modes:
+        hf = wp * wp / (wz * wz)
+        a1, a0 = 2.0 * zetap * wp, wp * wp
+        c1, c0 = hf * 2.0 * zetaz * wz - hf * a1, hf * wz * wz - hf * a0
+        af = np.array([[-a1, 1.0], [-a0, 0.0]])
+        bf = np.array([[c1], [c0]])
+        cf = np.array([[1.0, 0.0]])
+        n = a.shape[0]
+        big = np.zeros((n + 2, n + 2))
+        big[:n, :n] = a
+        big[:n, n:] = bu_x @ cf
+        big[n:, n:] = af
+        bu_x = np.vstack([bu_x * hf, bf])
+        bt_x = np.vstack([bt_x, np.zeros((2, 1))])
+        c_x = np.hstack([c_x, np.zeros((1, 2))])
+        a = big
+    n = a.shape[0]
+    c = r * r / 2.0
+    rho = kbw / c ** 2
+    aa = np.zeros((n + 1, n + 1))
+    aa[:n, :n] = a
+    aa[n, :n] = -c_x[0]
+    ba = np.vstack([bu_x, [[0.0]]])
+    q = np.zeros(n + 1)
+    q[1], q[2], q[n] = 20.0, rho, 20.0
+    kk = lqr(aa, ba, np.diag(q), rho)
+    ae = np.zeros((n + 1, n + 1))
+    ae[:n, :n] = a
+    ae[:n, n:n + 1] = bt_x
+    be = np.vstack([bu_x, [[0.0]]])
+    ce = np.hstack([c_x, [[0.0]]])
+    g = np.zeros((n + 1, n + 1))
+    g[0, 0] = 1.0
+    g[n, n] = 1.0
+    l = kalman(ae, ce, g, 0.1)
+    kx = np.hstack([kk[:, :n], [[0.0]]])  # over [plant, Tl]: the load-torque estimate is not fed back
+    k_xi = kk[0, n]
+    ac = np.zeros((n + 2, n + 2))
+    ac[:n + 1, :n + 1] = ae - be @ kx - l @ ce
+    ac[:n + 1, n + 1:] = -be * k_xi
+    bc = np.zeros((n + 2, 2))
+    bc[:n + 1, 1:2] = l
+    bc[n + 1, 0] = 1.0
+    bc[n + 1, 1] = -1.0
+    cc = np.hstack([-kx, [[-k_xi]]])
+    # closed loop: plant x' = a x + bu_x u + bt_x tl, y = c_x x; u = cc xc (kff = 0, no D)
+    m = n + n + 2
+    acl = np.zeros((m, m))
+    acl[:n, :n] = a
+    acl[:n, n:] = bu_x @ cc
+    acl[n:, :n] = bc[:, 1:2] @ c_x
+    acl[n:, n:] = ac
+    return {
+        "r": r, "zeta_z": zz, "kbw": kbw, "modes": [list(mo) for mo in modes],
+        "lqr_poles": cplx(np.linalg.eigvals(aa - ba @ kk)),
+        "kf_poles": cplx(np.linalg.eigvals(ae - l @ ce)),
+        "controller_poles": cplx(np.linalg.eigvals(ac)),
+        "closed_loop_poles": cplx(np.linalg.eigvals(acl)),
+    }
+
+
 def peak(f):
     w = np.logspace(-3, 3, 200001)
     mags = np.array([abs(f(x)) for x in w[::50]])
@@ -221,10 +289,12 @@ def main():
     ]
     position = [position_case(3.0, 0.01, 1.0), position_case(2.0, 0.02, 0.5, bm=0.05, bl=0.1)]
     load_side = [load_side_case(3.0, 0.01, 1.0), load_side_case(5.0, 0.01, 0.3, bm=0.05, bl=0.1)]
+    modal = [modal_case(2.0, 0.02, 1.0, [(3.2, 0.01, 7.4, 0.005)]),
+             modal_case(3.0, 0.01, 0.5, [(4.0, 0.02, 6.0, 0.01), (9.0, 0.01, 14.0, 0.02)])]
     os.makedirs(os.path.dirname(OUT), exist_ok=True)
     with open(OUT, "w") as f:
         json.dump({"generator": "tools/reference/tuning_lqg_reference.py", "velocity": velocity, "position": position,
-                   "load_side": load_side}, f, indent=1)
+                   "load_side": load_side, "modal": modal}, f, indent=1)
     e29 = velocity[0]
     print("E29 K =", np.round(e29["K"], 3), "lqr |p| =", sorted(round(math.hypot(*p), 3) for p in e29["lqr_poles"]))
     print("E29 KF poles =", e29["kf_poles"])

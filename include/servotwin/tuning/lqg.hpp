@@ -84,6 +84,22 @@ struct LqgDesign {
 /// not finite and > 0 (kff, q >= 0), or a plant without stiffness.
 [[nodiscard]] LqgDesign velocity_lqg(const FrictionTwoMass& plant, double r, const VelocityLqgOptions& options = {});
 
+/// The velocity LQG on a plant with higher modes (C7.16: "just extend the model"): each mode
+/// enters the design model as its unit-DC-gain factor of NormalizedPlant::motor(true), in series
+/// with the motor torque (two states per mode, appended after [ωm, ωl, Ts]; no weight in Q and no
+/// process noise on them), so the model's motor response is the full plant's and both the
+/// regulator and the estimator know the modes. The compensator has 5 + 2·modes states. Without
+/// modes this is velocity_lqg(plant, r, options). core::InputError also for a mode that is not a
+/// stable pair (resonance and antiresonance > 0, dampings >= 0).
+[[nodiscard]] LqgDesign velocity_lqg(const FrictionTwoMass& plant, std::span<const fit::Mode> higher_modes, double r,
+                                     const VelocityLqgOptions& options = {});
+
+/// The two-mass velocity model (two_mass_state_space, velocity) with `higher_modes` in series with
+/// the motor torque, as velocity_lqg designs on: states [ωm, ωl, Ts, two per mode], inputs
+/// [Tm, Tl], outputs [ωm, ωl].
+[[nodiscard]] core::StateSpace two_mass_state_space_with_modes(const FrictionTwoMass& plant,
+                                                               std::span<const fit::Mode> higher_modes);
+
 /// The load-side LQG of C7.17 (the velocity options; raw_motor_velocity is refused: core::InputError).
 [[nodiscard]] LqgDesign load_side_lqg(const FrictionTwoMass& plant, double r, const VelocityLqgOptions& options = {});
 

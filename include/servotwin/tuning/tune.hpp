@@ -87,7 +87,8 @@ struct TuneOptions {
   double xi_v = 0.8;  ///< hinf: damping of the relocated resonant pair, [0.707, 1]
   /// hinf on a plant with higher modes (C7.16): kActive designs on the full model and damps every
   /// mode; kPassive designs on it and cancels the higher ones (a notch); kFirstMode designs on
-  /// mode 1 and only checks the full model. No effect on a two-mass plant.
+  /// mode 1 and only checks the full model. lqg/lqg+p: kFirstMode designs on mode 1, the others on
+  /// the model extended by the higher modes (velocity_lqg with modes). No effect on a two-mass plant.
   ModeHandling hinf_modes = ModeHandling::kActive;
   /// hinf: the compensator's states after balanced truncation (the search designs every candidate
   /// at this order); std::nullopt: the minimal realization (VelocityHinfWeights::controller_order).
