@@ -850,7 +850,11 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
     tune_cascade(result, options, check);
   }
   if (!plant.higher_modes.empty()) c.notes.push_back(higher_modes_note(options, plant.higher_modes));
-  if (const std::optional<std::string> note = estimated_load_note(plant)) c.notes.push_back(*note);
+  // The note matters where a load side is used: the loop's load numbers, the LQG's design model or
+  // the position loop (both on the first mode's realization).
+  const bool lqg = options.structure == Structure::kLqg || options.structure == Structure::kLqgP;
+  const bool uses_load = plant.load_estimate() || lqg || has_position_loop(options.structure);
+  if (const std::optional<std::string> note = estimated_load_note(plant); note && uses_load) c.notes.push_back(*note);
   if (options.min_damping && c.predicted.min_damping < *options.min_damping)
     c.notes.push_back(fmt::format("least closed-loop damping {:.3g} is below --min-damping {:.3g}: the given design "
                                   "parameter was kept (the automatic search enforces the floor)",

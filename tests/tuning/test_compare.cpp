@@ -160,6 +160,12 @@ TEST(CompareStructures, TestBedOneHasALoadSideOnlyAsAChain) {
   const std::vector<StructureComparison> motor_only = compare_structures(test_bed_1(), o, {Structure::kPi});
   ASSERT_TRUE(motor_only.front().result.has_value());
   EXPECT_TRUE(std::isnan(motor_only.front().result->controller.predicted.bandwidth_load));
+  const auto estimate_noted = [](const Controller& c) {
+    bool noted = false;
+    for (const std::string& n : c.notes) noted |= n.find("load side is an estimate") != std::string::npos;
+    return noted;
+  };
+  EXPECT_FALSE(estimate_noted(motor_only.front().result->controller));  // no load numbers to qualify
   o.chain_load = true;
   const std::vector<StructureComparison> c = compare_structures(test_bed_1(), o, {Structure::kPi, Structure::kHinf});
   const StructureComparison& pi = entry(c, Structure::kPi);
@@ -176,6 +182,7 @@ TEST(CompareStructures, TestBedOneHasALoadSideOnlyAsAChain) {
   EXPECT_NE(pi.result->controller.design.omega_star_source.find("load through the chain"), std::string::npos);
   EXPECT_GT(h.bandwidth_load, 2.0 * p.bandwidth_load);
   EXPECT_GT(h.overshoot, 2.0 * p.overshoot);
+  EXPECT_TRUE(estimate_noted(pi.result->controller));
   // The LQG "on the full model" (A6): designed on the first mode it is destabilized by mode 2 and
   // the lag at every kbw; with the model extended by mode 2 (C7.16) it designs, 7 states.
   o.structure = Structure::kLqg;
