@@ -111,10 +111,11 @@ std::vector<vcnc::DriveSimulation> simulate_on_plant(const TunePlant& plant,
     try {
       const vcnc::DriveSimulation step = vcnc::simulate_drive(*plant.description, c.result->controller);
       const vcnc::DriveMetrics &m = step.metrics, &l = step.linear_metrics;
+      const std::string step_cells =
+          fmt::format("{:<6} {:>10.1f} / {:>8.1f} {:>11} / {:>9} {:>12.3g} |", name, 100.0 * m.overshoot,
+                      100.0 * l.overshoot, time_or_never(m.settling_time), time_or_never(l.settling_time), m.final_error);
       if (!vcnc::has_load_torque_input(*plant.description)) {
-        fmt::print("{:<6} {:>10.1f} / {:>8.1f} {:>11} / {:>9} {:>12.3g} | {:>19}\n", name, 100.0 * m.overshoot,
-                   100.0 * l.overshoot, time_or_never(m.settling_time), time_or_never(l.settling_time), m.final_error,
-                   "n/a (no load input)");
+        fmt::print("{} {:>19}\n", step_cells, "n/a (no load input)");
         runs.push_back(step);
         continue;
       }
@@ -124,10 +125,8 @@ std::vector<vcnc::DriveSimulation> simulate_on_plant(const TunePlant& plant,
       settings.amplitude = *load_torque;
       const vcnc::DriveSimulation load = vcnc::simulate_drive(*plant.description, c.result->controller, settings);
       const vcnc::DriveMetrics &ml = load.metrics, &ll = load.linear_metrics;
-      fmt::print("{:<6} {:>10.1f} / {:>8.1f} {:>11} / {:>9} {:>12.3g} | {:>9.4g} / {:>7.4g} {:>11} / {:>9}\n", name,
-                 100.0 * m.overshoot, 100.0 * l.overshoot, time_or_never(m.settling_time), time_or_never(l.settling_time),
-                 m.final_error, ml.peak_deviation, ll.peak_deviation, time_or_never(ml.recovery_time),
-                 time_or_never(ll.recovery_time));
+      fmt::print("{} {:>9.4g} / {:>7.4g} {:>11} / {:>9}\n", step_cells, ml.peak_deviation, ll.peak_deviation,
+                 time_or_never(ml.recovery_time), time_or_never(ll.recovery_time));
       runs.push_back(step);
       runs.push_back(load);
     } catch (const core::InputError& e) {

@@ -227,11 +227,7 @@ core::StateSpace two_mass_state_space_with_modes(const FrictionTwoMass& plant, s
     detail::require_positive(m.resonance.omega_rad_s, field + ".resonance.omega_rad_s", "a frequency");
     detail::require_non_negative(m.antiresonance.zeta, field + ".antiresonance.zeta", "a damping");
     detail::require_non_negative(m.resonance.zeta, field + ".resonance.zeta", "a damping");
-    const double wz = m.antiresonance.omega_rad_s, wp = m.resonance.omega_rad_s;
-    const double hf = (wp * wp) / (wz * wz);  // 1/DC gain of the ratio of quadratics: unit DC gain overall
-    const core::StateSpace f = core::to_state_space(core::TransferFunction(
-        hf * core::Polynomial{1.0, 2.0 * m.antiresonance.zeta * wz, wz * wz},
-        core::Polynomial{1.0, 2.0 * m.resonance.zeta * wp, wp * wp}));
+    const core::StateSpace f = core::to_state_space(mode_factor(m));
     // The factor's output is the torque the model so far is driven with: Tm' = Cf xf + Df Tm.
     const Eigen::Index n = out.A.rows(), k = f.A.rows();
     core::StateSpace s;

@@ -187,13 +187,18 @@ void validate(const HfDynamics& hf, const std::string& prefix) {
 
 // ---------------------------------------------------------------- NormalizedPlant
 
+core::TransferFunction mode_factor(const fit::Mode& mode) {
+  return {(1.0 / mode_dc_gain(mode)) * quadratic_polynomial(mode.antiresonance), quadratic_polynomial(mode.resonance)};
+}
+
 core::TransferFunction NormalizedPlant::motor(bool with_higher_modes) const {
   Polynomial num{1.0, 2.0 * zeta_z, 1.0};
   Polynomial den = Polynomial{1.0, a} * Polynomial{1.0, 2.0 * zeta_p * r, r * r};
   if (with_higher_modes) {
     for (const fit::Mode& m : higher_modes) {
-      num = (1.0 / mode_dc_gain(m)) * (num * quadratic_polynomial(m.antiresonance));
-      den = den * quadratic_polynomial(m.resonance);
+      const core::TransferFunction factor = mode_factor(m);
+      num = num * factor.num();
+      den = den * factor.den();
     }
   }
   return {num, den};

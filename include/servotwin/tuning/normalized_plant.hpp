@@ -108,6 +108,10 @@ struct NormalizedPlant {
   [[nodiscard]] double physical_time(double t) const noexcept { return t / omega_z; }
 };
 
+/// One higher mode's unit-DC-gain factor (ωi²/ωzi²)(s² + 2ζzi ωzi s + ωzi²)/(s² + 2ζi ωi s + ωi²),
+/// as NormalizedPlant::motor(true) multiplies it in (numerator and denominator as they enter).
+[[nodiscard]] core::TransferFunction mode_factor(const fit::Mode& mode);
+
 /// Normalizes a fitted plant model (plan §1.1). The first mode (lowest resonance) gives ωz, r,
 /// ζz, ζp; the modes are sorted by resonance frequency. Im = 1/(K·Π_{i≥2}(ωzi/ωi)²·g_lag), where
 /// g_lag = 1/p is the DC gain of the model's lag 1/(s + p): the lag itself moves into `hf` as
