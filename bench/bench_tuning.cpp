@@ -122,7 +122,9 @@ BENCHMARK(BM_LargestRobustOmegaStar)->Arg(30)->Arg(48)->Unit(benchmark::kMillise
 // (indices, margins, time responses). Arg 0: PI; 1: PI with an uncertainty weight (RP in the scan);
 // 2: PID; 3: PI + P position loop; 4: LQG (kbw and kff searches, C7.13); 5: LQG with W2;
 // 6: H∞ with the automatic ω0S/ω0T search (C7.14; issue §9: <= 1 s), on the belt axis's full two-mode
-// model (C7.16 active, the default: a 12-state generalized plant).
+// model (C7.16 active, the default: a 12-state generalized plant); 7: the position LQG (lqg-pos,
+// kbw search with a prefilter bisection per candidate); 8: the position H∞ (hinf-pos: cubic
+// weights, 14-state generalized plant, and the prefilter).
 void BM_TuneAutomatic(benchmark::State& state) {
   const fit::PlantModel model = belt_axis();
   TuneOptions o;
@@ -149,13 +151,19 @@ void BM_TuneAutomatic(benchmark::State& state) {
     case 6:  // hinf: the w0S scan with the w0T ladder, each candidate a gamma iteration
       o.structure = Structure::kHinf;
       break;
+    case 7:
+      o.structure = Structure::kLqgPos;
+      break;
+    case 8:
+      o.structure = Structure::kHinfPos;
+      break;
     default:
       break;
   }
   for (auto _ : state) benchmark::DoNotOptimize(tune(model, o));
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_TuneAutomatic)->DenseRange(0, 6)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TuneAutomatic)->DenseRange(0, 8)->Unit(benchmark::kMillisecond);
 
 /// One C7.14 velocity design (generalized plant, gamma iteration to 1e-4 with the closed loop
 /// checked near the optimum, K0/s): the inner step of the w0S search; a few milliseconds.

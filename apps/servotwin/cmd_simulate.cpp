@@ -100,7 +100,7 @@ void print_summary(const vcnc::DriveSimulation& sim, const std::string& plant_so
   fmt::print("{} test, {} controller on {} (ts = {:.4g} s, {} samples, {:.4g} s); controlled variable: {} {}\n",
              vcnc::to_string(sim.test), tuning::to_string(sim.structure), plant_source, sim.ts, sim.samples.size(),
              sim.samples.back().t, sim.load_side ? "load" : "motor",
-             tuning::has_position_loop(sim.structure) ? "position" : "velocity");
+             tuning::controls_position(sim.structure) ? "position" : "velocity");
   print_metrics("plant", sim.metrics, sim.test);
   print_metrics("linear", sim.linear_metrics, sim.test);
   for (const std::string& n : sim.notes) fmt::print("note: {}\n", n);
@@ -184,7 +184,7 @@ int run_frame_sequence(const SimulateArgs& a, const GlobalOptions& global, const
   if (!plant.frame)
     throw core::InputError(core::at_field("--test"), "frame-sequence needs a flexible-frame plant (type flexible-frame "
                                                      "or the preset c7.19-frame); " + plant_source + " is not one");
-  if (tuning::has_position_loop(loaded.controller.structure))
+  if (tuning::controls_position(loaded.controller.structure))
     throw core::InputError(core::at_field("--test"), "frame-sequence is a velocity-loop test; this controller closes a "
                                                      "position loop");
   if (!a.report.empty())

@@ -61,6 +61,7 @@ tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
   o.lqg.raw_motor_velocity = a.raw_motor_velocity;
   if (a.measurement_noise) {
     o.lqg.measurement_noise = *a.measurement_noise;  // the user's V is kept, not raised
+    o.lqg_position.measurement_noise = *a.measurement_noise;
     o.raise_measurement_noise = false;
   }
   o.target_r = parse_auto(a.target_r, "--target-r", false, "a resonance ratio > 1");
@@ -101,8 +102,27 @@ void print_position_loop(const tuning::Controller& c, double hz) {
              c.position->bandwidth_load * hz, c.position->j2);
 }
 
+/// A position controller's prefilter (C7.13), in seconds.
+void print_prefilter(const tuning::FullOrderSummary& f, const tuning::PlantScales& scales) {
+  if (f.prefilter_tau == 0.0)
+    fmt::print("reference prefilter: none needed (the load position does not overshoot without it)\n");
+  else
+    fmt::print("reference prefilter: 1/(tau s + 1), tau = {:.4g} s (the smallest keeping the load position free of "
+               "overshoot, C7.13)\n",
+               f.prefilter_tau / scales.omega_z);
+}
+
 /// The LQG part of the summary: kbw, kff and the compensator's stability.
 void print_lqg(tuning::Structure structure, const tuning::FullOrderSummary& f, const tuning::PlantScales& scales) {
+  if (f.position_weights) {
+    fmt::print("structure {}: LQG position loop (C7.13, {} states with the prefilter): kbw = {:.4g} ({}), Kalman "
+               "filter V = {:g}\n",
+               tuning::to_string(structure), f.compensator.states(), f.position_weights->kbw, f.kbw_source,
+               f.position_weights->measurement_noise);
+    print_prefilter(f, scales);
+    fmt::print("compensator: {}\n", f.controller_stable ? "stable" : "UNSTABLE (stable only inside the closed loop)");
+    return;
+  }
   fmt::print("structure {}: LQG velocity loop (C7.13, {} states): kbw = {:.4g} ({}), feedforward kff = {:.4g} "
              "normalized = {:.4g} torque per velocity ({})\n",
              tuning::to_string(structure), f.compensator.states(), f.weights.kbw, f.kbw_source, f.weights.feedforward,
@@ -111,12 +131,16 @@ void print_lqg(tuning::Structure structure, const tuning::FullOrderSummary& f, c
 }
 
 /// The H-infinity part of the summary: the weights, gamma and the controller's stability.
-void print_hinf(const tuning::FullOrderSummary& f, double hz) {
+void print_hinf(tuning::Structure structure, const tuning::FullOrderSummary& f, const tuning::PlantScales& scales) {
   const tuning::HinfSummary& h = *f.hinf;
-  fmt::print("structure hinf: mixed-sensitivity velocity loop (C7.14, {} states): w0S = {:.4g} omega_z = {:.4g} Hz "
+  const double hz = scales.omega_z / kTwoPi;
+  const bool position = tuning::is_position_controller(structure);
+  fmt::print("structure {}: mixed-sensitivity {} loop (C7.14, {} states{}): w0S = {:.4g} omega_z = {:.4g} Hz "
              "({}), w0T = {:.4g} omega_z, xi_v = {}; gamma = {:.4g} (optimum {:.4g})\n",
-             f.compensator.states(), h.omega_0s, h.omega_0s * hz, h.omega_0s_source, h.omega_0t, h.xi_v, h.gamma,
-             h.gamma_optimal);
+             tuning::to_string(structure), position ? "position" : "velocity", f.compensator.states(),
+             position && f.prefilter_tau > 0.0 ? " with the prefilter" : "", h.omega_0s, h.omega_0s * hz,
+             h.omega_0s_source, h.omega_0t, h.xi_v, h.gamma, h.gamma_optimal);
+  if (position) print_prefilter(f, scales);
   if (h.modes != tuning::ModeHandling::kFirstMode)
     fmt::print("higher modes: {} (C7.16)\n", h.modes == tuning::ModeHandling::kActive
                                                  ? "designed with, damped actively (V extended, eq. 7.164)"
@@ -143,7 +167,7 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
              source, hz, p.r, p.zeta_z, p.zeta_p, p.a, p.motor_inertia,
              p.higher_modes.empty() ? "" : fmt::format(", {} higher mode(s)", p.higher_modes.size()));
   if (c.full_order && c.full_order->hinf) {
-    print_hinf(*c.full_order, hz);
+    print_hinf(c.structure, *c.full_order, c.plant);
   } else if (c.full_order) {
     print_lqg(c.structure, *c.full_order, c.plant);
   } else {
@@ -151,8 +175,11 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
   }
   print_position_loop(c, hz);
   const tuning::LoopIndices& i = c.predicted;
-  fmt::print("predicted (with the known HF dynamics): {}\n", i.closed_loop_stable ? "stable" : "UNSTABLE");
-  fmt::print("  bandwidth: motor {:.4g} Hz, load {}\n", i.bandwidth_motor * hz,
+  // A position controller's indices judge positions (phi/phi*, phi_l/T_l).
+  const bool position = tuning::is_position_controller(c.structure);
+  fmt::print("predicted (with the known HF dynamics{}): {}\n", position ? "; positions" : "",
+             i.closed_loop_stable ? "stable" : "UNSTABLE");
+  fmt::print("  {}bandwidth: motor {:.4g} Hz, load {}\n", position ? "position " : "", i.bandwidth_motor * hz,
              std::isnan(i.bandwidth_load) ? std::string(p.higher_modes.empty()
                                                             ? "n/a (no two-mass realization with friction >= 0: no load side)"
                                                             : "n/a (higher modes: no load side)")
@@ -160,13 +187,14 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
   if (std::isnan(i.peak_tl))
     fmt::print("  peaks: ||S|| = {:.3g}, ||T|| = {:.3g} (no load side)\n", i.peak_s, i.peak_t);
   else
-    fmt::print("  peaks: ||S|| = {:.3g}, ||T|| = {:.3g}, ||wl/w*|| = {:.3g}; J2 = {:.3g}\n", i.peak_s, i.peak_t, i.peak_tl, i.j2);
+    fmt::print("  peaks: ||S|| = {:.3g}, ||T|| = {:.3g}, {} = {:.3g}; J2 = {:.3g}\n", i.peak_s, i.peak_t,
+               position ? "||phi_l/phi*|| (with the prefilter)" : "||wl/w*||", i.peak_tl, i.j2);
   fmt::print("  least closed-loop damping: {:.3g}{}\n", i.min_damping,
              c.design.min_damping ? fmt::format(" (required >= {:.3g})", *c.design.min_damping) : std::string());
   fmt::print("  margins: gain {}, phase {}, modulus {:.3g}\n", margin(i.gain_margin_db, "dB"),
              margin(i.phase_margin_deg, "deg"), i.modulus_margin);
-  fmt::print("  step: overshoot {:.1f} %, 2 % settling {:.4g} s; load-step ITAE {:.4g} (normalized)\n",
-             100.0 * i.overshoot, p.physical_time(i.settling_time), i.itae_load_step);
+  fmt::print("  {}step: overshoot {:.1f} %, 2 % settling {:.4g} s; load-step ITAE {:.4g} (normalized)\n",
+             position ? "position " : "", 100.0 * i.overshoot, p.physical_time(i.settling_time), i.itae_load_step);
   if (c.robustness.rs) {
     fmt::print("  robustness: ||W2 T|| = {:.4f} (RS {}), ||S||/Ms = {:.4f}, RP {:.4f} ({})\n", *c.robustness.rs,
                *c.robustness.rs < 1.0 ? "ok" : "FAILS", *c.robustness.np, *c.robustness.rp,
@@ -262,9 +290,10 @@ void register_tune(CLI::App& app, Action& selected) {
                   "(servotwin.plant/1) or a flexible preset name");
   cmd->add_option("--structure", a->structure,
                   "pi, pid (virtual inertia, C7.5), pi+p (P position loop over the PI), lqg (full-order velocity "
-                  "LQG, C7.13), lqg+p (P position loop over the LQG) or hinf (H-infinity mixed-sensitivity velocity "
-                  "loop, C7.14)")
-      ->check(CLI::IsMember({"pi", "pid", "pi+p", "lqg", "lqg+p", "hinf"}))
+                  "LQG, C7.13), lqg+p (P position loop over the LQG), hinf (H-infinity mixed-sensitivity velocity "
+                  "loop, C7.14), lqg-pos (full-order position LQG with its reference prefilter, C7.13) or hinf-pos "
+                  "(H-infinity position loop with a reference prefilter, C7.14)")
+      ->check(CLI::IsMember({"pi", "pid", "pi+p", "lqg", "lqg+p", "hinf", "lqg-pos", "hinf-pos"}))
       ->capture_default_str();
   cmd->add_option("--zeta-star", a->zeta_star, "Damping of the assigned closed-loop pole pair")->capture_default_str();
   cmd->add_option("--omega-star", a->omega_star,
@@ -320,6 +349,7 @@ void register_tune(CLI::App& app, Action& selected) {
                "  servotwin tune plant_model.json --w2-from-frf frf.csv\n"
                "  servotwin tune table-5.1 --structure lqg --ts 0.000125 -o lqg.json --report lqg.html\n"
                "  servotwin tune table-5.1 --structure hinf --ts 0.000125 -o hinf.json\n"
+               "  servotwin tune table-5.1 --structure lqg-pos --ts 0.000125 -o lqg-pos.json\n"
                "  servotwin tune plant_model.json --delay 0.0005 --w2-num 2.6,0 --w2-den 1,15 --ms 1.6\n");
   add_tune_compare(*cmd, selected);
   cmd->callback([a, cmd, &selected] {

@@ -31,6 +31,12 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 /// any deliberate edit.
 constexpr double kRelTol = 1e-6;
 constexpr std::array<const char*, 2> kInputNames = {"velocity_reference", "motor_velocity"};
+constexpr std::array<const char*, 2> kPositionInputNames = {"position_reference", "motor_position"};
+
+/// The controller's inputs: [ω*, ωm], or [φ*, φm] for a full-order position controller.
+const std::array<const char*, 2>& input_names(Structure s) {
+  return tuning::is_position_controller(s) ? kPositionInputNames : kInputNames;
+}
 
 std::string show(double v) { return fmt::format("{:.9g}", v); }
 
@@ -38,7 +44,7 @@ bool agree(double given, double expected) {
   return std::abs(given - expected) <= kRelTol * std::max(std::abs(given), std::abs(expected));
 }
 
-std::string loop_name(Structure s) { return tuning::has_position_loop(s) ? "position" : "velocity"; }
+std::string loop_name(Structure s) { return tuning::controls_position(s) ? "position" : "velocity"; }
 
 // ---------------------------------------------------------------- writer
 
@@ -177,8 +183,8 @@ json position_json(const tuning::Controller& c, double omega_z) {
           {"peak_load_tracking", finite(p->peak_load_tracking, "position.peak_load_tracking")}};
 }
 
-json state_space_json(const core::StateSpace& ss, const std::string& section) {
-  return {{"inputs", kInputNames},
+json state_space_json(const core::StateSpace& ss, const std::string& section, Structure structure) {
+  return {{"inputs", input_names(structure)},
           {"output", "torque"},
           {"A", matrix_json(ss.A, section + ".A")},
           {"B", matrix_json(ss.B, section + ".B")},
@@ -186,14 +192,30 @@ json state_space_json(const core::StateSpace& ss, const std::string& section) {
           {"D", matrix_json(ss.D, section + ".D")}};
 }
 
-/// The compensator members common to the lqg and hinf sections.
-void add_compensator(json& section, const tuning::FullOrderSummary& f, const std::string& name) {
+/// The compensator members common to the lqg and hinf sections (a position controller's with its
+/// prefilter's time constant).
+void add_compensator(json& section, const tuning::FullOrderSummary& f, const std::string& name, Structure structure) {
+  if (tuning::is_position_controller(structure)) section["prefilter_tau"] = finite(f.prefilter_tau, name + ".prefilter_tau");
   section["controller_stable"] = f.controller_stable;
   section["controller_poles"] = poles_json(f.controller_poles, name + ".controller_poles");
-  section["compensator"] = state_space_json(f.compensator, name + ".compensator");
+  section["compensator"] = state_space_json(f.compensator, name + ".compensator", structure);
 }
 
-json hinf_json(const std::optional<tuning::FullOrderSummary>& f) {
+json position_lqg_json(const tuning::FullOrderSummary& f, Structure structure) {
+  const tuning::PositionLqgOptions& w = *f.position_weights;
+  json q = json::array();
+  for (Eigen::Index i = 0; i < w.q.size(); ++i) q.push_back(finite(w.q(i), "lqg.q"));
+  json out = {{"kbw", finite(w.kbw, "lqg.kbw")},
+              {"kbw_source", f.kbw_source},
+              {"feedforward_source", f.feedforward_source},
+              {"q", q},
+              {"process_noise", finite(w.process_noise, "lqg.process_noise")},
+              {"measurement_noise", finite(w.measurement_noise, "lqg.measurement_noise")}};
+  add_compensator(out, f, "lqg", structure);
+  return out;
+}
+
+json hinf_json(const std::optional<tuning::FullOrderSummary>& f, Structure structure) {
   if (!f || !f->hinf) return nullptr;
   const tuning::HinfSummary& h = *f->hinf;
   json out = {{"omega_0s", finite(h.omega_0s, "hinf.omega_0s")},
@@ -206,12 +228,13 @@ json hinf_json(const std::optional<tuning::FullOrderSummary>& f) {
               {"full_order", h.full_order},
               {"hankel_singular_values", numbers_json(h.hankel, "hinf.hankel_singular_values")},
               {"reduction_error_bound", finite(h.reduction_error_bound, "hinf.reduction_error_bound")}};
-  add_compensator(out, *f, "hinf");
+  add_compensator(out, *f, "hinf", structure);
   return out;
 }
 
-json lqg_json(const std::optional<tuning::FullOrderSummary>& f) {
+json lqg_json(const std::optional<tuning::FullOrderSummary>& f, Structure structure) {
   if (!f || f->hinf) return nullptr;
+  if (f->position_weights) return position_lqg_json(*f, structure);
   const tuning::VelocityLqgOptions& w = f->weights;
   json out = {{"kbw", finite(w.kbw, "lqg.kbw")},
           {"kbw_source", f->kbw_source},
@@ -223,7 +246,7 @@ json lqg_json(const std::optional<tuning::FullOrderSummary>& f) {
           {"noise_load_torque", finite(w.noise_load_torque, "lqg.noise_load_torque")},
           {"measurement_noise", finite(w.measurement_noise, "lqg.measurement_noise")},
           {"raw_motor_velocity", w.raw_motor_velocity}};
-  add_compensator(out, *f, "lqg");
+  add_compensator(out, *f, "lqg", structure);
   return out;
 }
 
@@ -331,7 +354,7 @@ void read_matrices(const Section& s, Eigen::MatrixXd& a, Eigen::MatrixXd& b, Eig
 /// the other. `response(sys, ω)` evaluates a 1×2 response.
 template <typename System, typename Response>
 void check_realization(const Section& parent, std::string_view key, const System& file, const System& expected,
-                       const std::vector<double>& omegas, Response response) {
+                       const std::vector<double>& omegas, Response response, Structure structure) {
   for (double w : omegas) {
     const Eigen::MatrixXcd g = response(file, w);
     const Eigen::MatrixXcd e = response(expected, w);
@@ -341,7 +364,7 @@ void check_realization(const Section& parent, std::string_view key, const System
       if (!(std::abs(diff) <= kRelTol * scale))
         parent.fail(key, fmt::format("does not realize the controller of \"gains\": at {} Hz the response from {} is "
                                      "{}{:+.9g}j, the gains give {}{:+.9g}j (agreement within {} relative expected)",
-                                     show(w / kTwoPi), kInputNames[static_cast<std::size_t>(k)], show(g(0, k).real()),
+                                     show(w / kTwoPi), input_names(structure)[static_cast<std::size_t>(k)], show(g(0, k).real()),
                                      g(0, k).imag(), show(e(0, k).real()), e(0, k).imag(), kRelTol));
     }
   }
@@ -582,11 +605,12 @@ std::vector<double> continuous_check_frequencies(double omega_z, const tuning::P
 }
 
 /// The members "inputs", "output", "A".."D" of a controller state space.
-core::StateSpace read_controller_matrices(const Section& s) {
+core::StateSpace read_controller_matrices(const Section& s, Structure structure) {
   s.object.allow_only({"inputs", "output", "A", "B", "C", "D"});
   const json& inputs = s.raw("inputs");
-  if (inputs != json(kInputNames))
-    s.fail("inputs", "expected [\"velocity_reference\", \"motor_velocity\"], got " + inputs.dump());
+  if (inputs != json(input_names(structure)))
+    s.fail("inputs", "expected " + json(input_names(structure)).dump() + " for a \"" + to_string(structure) +
+                         "\" controller, got " + inputs.dump());
   s.expect_string("output", "torque");
   core::StateSpace out;
   read_matrices(s, out.A, out.B, out.C, out.D);
@@ -594,10 +618,11 @@ core::StateSpace read_controller_matrices(const Section& s) {
 }
 
 /// The physical state space must realize `expected` (the gains', or the compensator de-normalized).
-void read_state_space(const Section& root, const core::StateSpace& expected, const std::vector<double>& omegas) {
-  const core::StateSpace file = read_controller_matrices(root.section("state_space"));
+void read_state_space(const Section& root, const core::StateSpace& expected, const std::vector<double>& omegas,
+                      Structure structure) {
+  const core::StateSpace file = read_controller_matrices(root.section("state_space"), structure);
   const auto response = [](const core::StateSpace& sys, double w) { return core::frequency_response(sys, w); };
-  check_realization(root, "state_space", file, expected, omegas, response);
+  check_realization(root, "state_space", file, expected, omegas, response, structure);
 }
 
 std::optional<core::DiscreteStateSpace> read_discrete(const Section& root, const tuning::Controller& c,
@@ -622,7 +647,7 @@ std::optional<core::DiscreteStateSpace> read_discrete(const Section& root, const
   for (double k : {1e-3, 1e-2, 0.1, 0.3, 0.6, 0.9}) omegas.push_back(k * kTwoPi * nyquist_hz);
   if (prewarp_rad_s) omegas.push_back(*prewarp_rad_s);
   const auto response = [](const core::DiscreteStateSpace& sys, double w) { return core::frequency_response(sys, w); };
-  check_realization(root, "discrete", file, expected, omegas, response);
+  check_realization(root, "discrete", file, expected, omegas, response, c.structure);
   return file;
 }
 
@@ -658,9 +683,25 @@ bool section_present(const Section& root, const char* key, bool wanted, const st
   return present;
 }
 
+/// A position controller's prefilter time constant: >= 0, and when > 0 the compensator's first
+/// state is the prefilter's (tuning::with_prefilter: x' = (φ* − x)/τ).
+void read_prefilter(const Section& s, tuning::FullOrderSummary& f) {
+  f.prefilter_tau = s.non_negative("prefilter_tau", "a time constant");
+  const double tau = f.prefilter_tau;
+  if (tau == 0.0) return;
+  const Eigen::MatrixXd& a = f.compensator.A;
+  const Eigen::MatrixXd& b = f.compensator.B;
+  const bool first_state = a.rows() > 0 && b.rows() > 0 && b.cols() == 2 && agree(a(0, 0), -1.0 / tau) &&
+                           agree(b(0, 0), 1.0 / tau) && (a.row(0).tail(a.cols() - 1).array() == 0.0).all() &&
+                           b(0, 1) == 0.0;
+  if (!first_state)
+    s.fail("prefilter_tau", "is " + show(tau) + " but the compensator's first state is not the prefilter x' = (r - x)/tau");
+}
+
 /// The compensator, its poles (checked against its A) and its stability flag (checked against them).
-void read_compensator(const Section& s, tuning::FullOrderSummary& f) {
-  f.compensator = read_controller_matrices(s.section("compensator"));
+void read_compensator(const Section& s, tuning::FullOrderSummary& f, Structure structure) {
+  f.compensator = read_controller_matrices(s.section("compensator"), structure);
+  if (tuning::is_position_controller(structure)) read_prefilter(s, f);
   f.controller_poles = read_poles(s, "controller_poles");
   check_poles(s, "controller_poles", f.controller_poles, f.compensator.A);
   f.controller_stable = s.boolean("controller_stable");
@@ -693,11 +734,13 @@ void read_reduction(const Section& s, Eigen::Index states, tuning::HinfSummary& 
 
 /// The "hinf" section: the compensator, its weights and gamma for hinf; null otherwise.
 std::optional<tuning::FullOrderSummary> read_hinf(const Section& root, Structure structure) {
-  if (!section_present(root, "hinf", structure == Structure::kHinf, "hinf", structure)) return std::nullopt;
+  if (!section_present(root, "hinf", tuning::is_hinf(structure), "hinf and hinf-pos", structure)) return std::nullopt;
   const Section s = root.section("hinf");
-  s.object.allow_only({"omega_0s", "omega_0s_source", "omega_0t", "xi_v", "gamma_optimal", "gamma", "modes",
-                       "full_order", "hankel_singular_values", "reduction_error_bound", "controller_stable",
-                       "controller_poles", "compensator"});
+  std::vector<std::string_view> members{"omega_0s", "omega_0s_source", "omega_0t", "xi_v", "gamma_optimal", "gamma", "modes",
+                                        "full_order", "hankel_singular_values", "reduction_error_bound",
+                                        "controller_stable", "controller_poles", "compensator"};
+  if (tuning::is_position_controller(structure)) members.emplace_back("prefilter_tau");
+  s.object.allow_only(members);
   tuning::FullOrderSummary f;
   tuning::HinfSummary h;
   h.omega_0s = s.positive("omega_0s", "a normalized frequency w0S");
@@ -707,17 +750,42 @@ std::optional<tuning::FullOrderSummary> read_hinf(const Section& root, Structure
   h.gamma_optimal = s.positive("gamma_optimal", "an H-infinity norm");
   h.gamma = s.positive("gamma", "an H-infinity norm");
   if (h.gamma < h.gamma_optimal * (1.0 - 1e-9)) s.fail("gamma", "is below gamma_optimal");
-  read_compensator(s, f);
+  read_compensator(s, f, structure);
   read_reduction(s, f.compensator.states(), h);
   f.hinf = h;
   return f;
 }
 
-/// The "lqg" section: null for the cascade structures, the compensator and its weights for lqg.
+/// The lqg-pos "lqg" section: the position weights of C7.13, the prefilter and the compensator.
+tuning::FullOrderSummary read_position_lqg(const Section& s, Structure structure) {
+  s.object.allow_only({"kbw", "kbw_source", "feedforward_source", "q", "process_noise", "measurement_noise",
+                       "prefilter_tau", "controller_stable", "controller_poles", "compensator"});
+  tuning::FullOrderSummary f;
+  tuning::PositionLqgOptions w;
+  w.kbw = s.positive("kbw", "a bandwidth knob");
+  f.kbw_source = s.object.string("kbw_source");
+  f.feedforward_source = s.object.string("feedforward_source");
+  const std::vector<double> q = read_numbers(s, "q");
+  if (q.size() != static_cast<std::size_t>(w.q.size()))
+    s.fail("q", "expected the 5 state weights of [phi_m, w_m, phi_l, w_l, xi], got " + std::to_string(q.size()));
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    if (!(q[i] >= 0.0)) s.fail("q[" + std::to_string(i) + "]", "expected a state weight >= 0, got " + show(q[i]));
+    w.q(static_cast<Eigen::Index>(i)) = q[i];
+  }
+  w.process_noise = s.positive("process_noise", "a noise intensity");
+  w.measurement_noise = s.positive("measurement_noise", "a noise intensity");
+  f.position_weights = w;
+  read_compensator(s, f, structure);
+  return f;
+}
+
+/// The "lqg" section: null for the cascade structures, the compensator and its weights for lqg,
+/// lqg+p and lqg-pos.
 std::optional<tuning::FullOrderSummary> read_lqg(const Section& root, Structure structure) {
-  const bool wanted = structure == Structure::kLqg || structure == Structure::kLqgP;
-  if (!section_present(root, "lqg", wanted, "lqg and lqg+p", structure)) return std::nullopt;
+  const bool wanted = structure == Structure::kLqg || structure == Structure::kLqgP || structure == Structure::kLqgPos;
+  if (!section_present(root, "lqg", wanted, "lqg, lqg+p and lqg-pos", structure)) return std::nullopt;
   const Section s = root.section("lqg");
+  if (structure == Structure::kLqgPos) return read_position_lqg(s, structure);
   s.object.allow_only({"kbw", "kbw_source", "feedforward", "feedforward_source", "q_load_velocity", "q_integral",
                        "noise_motor", "noise_load_torque", "measurement_noise", "raw_motor_velocity",
                        "controller_stable", "controller_poles", "compensator"});
@@ -733,7 +801,7 @@ std::optional<tuning::FullOrderSummary> read_lqg(const Section& root, Structure 
   w.noise_load_torque = s.non_negative("noise_load_torque", "a noise intensity");
   w.measurement_noise = s.positive("measurement_noise", "a noise intensity");
   w.raw_motor_velocity = s.boolean("raw_motor_velocity");
-  read_compensator(s, f);
+  read_compensator(s, f, structure);
   return f;
 }
 
@@ -759,9 +827,11 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
     throw std::invalid_argument("controller_to_json: the position-loop summary belongs to exactly the pi+p and lqg+p controllers");
   const bool full_order = tuning::is_full_order(c.structure);
   if (full_order != c.full_order.has_value())
-    throw std::invalid_argument("controller_to_json: the compensator section belongs to exactly the lqg, lqg+p and hinf controllers");
-  if ((c.structure == Structure::kHinf) != (c.full_order && c.full_order->hinf.has_value()))
-    throw std::invalid_argument("controller_to_json: the H-infinity summary belongs to exactly the hinf controllers");
+    throw std::invalid_argument("controller_to_json: the compensator section belongs to exactly the full-order controllers");
+  if (tuning::is_hinf(c.structure) != (c.full_order && c.full_order->hinf.has_value()))
+    throw std::invalid_argument("controller_to_json: the H-infinity summary belongs to exactly the hinf and hinf-pos controllers");
+  if ((c.structure == Structure::kLqgPos) != (c.full_order && c.full_order->position_weights.has_value()))
+    throw std::invalid_argument("controller_to_json: the position-LQG weights belong to exactly the lqg-pos controllers");
   const double wz = finite(c.plant.omega_z, "plant.omega_z");
   const tuning::PlantScales& p = c.plant;
   const core::StateSpace ss = tuning::controller_state_space(c);
@@ -792,7 +862,7 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
             {"a", finite(p.a, "plant.a")}}},
           {"gains", full_order ? json(nullptr) : gains_json(c.physical, c.kpp_physical, "gains")},
           {"normalized", full_order ? json(nullptr) : gains_json(c.normalized, c.kpp_normalized, "normalized")},
-          {"state_space", state_space_json(ss, "state_space")},
+          {"state_space", state_space_json(ss, "state_space", c.structure)},
           {"discrete", discrete},
           {"design",
            {{"omega_star", full_order ? json(nullptr) : json(finite(d.omega_star, "design.omega_star"))},
@@ -806,8 +876,8 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
           {"predicted", predicted_json(c.predicted, wz)},
           {"robustness", robustness_json(c.robustness)},
           {"position", position_json(c, wz)},
-          {"lqg", lqg_json(c.full_order)},
-          {"hinf", hinf_json(c.full_order)},
+          {"lqg", lqg_json(c.full_order, c.structure)},
+          {"hinf", hinf_json(c.full_order, c.structure)},
           {"notes", c.notes}};
 }
 
@@ -823,7 +893,8 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
   const std::string structure = root.object.string("structure");
   const auto parsed = tuning::structure_from_string(structure);
   if (!parsed)
-    root.fail("structure", "expected \"pi\", \"pid\", \"pi+p\", \"lqg\", \"lqg+p\" or \"hinf\", got \"" + structure + "\"");
+    root.fail("structure", "expected \"pi\", \"pid\", \"pi+p\", \"lqg\", \"lqg+p\", \"hinf\", \"lqg-pos\" or \"hinf-pos\", got \"" +
+                               structure + "\"");
   c.structure = *parsed;
   const std::string loop = root.object.string("loop");
   if (loop != "velocity" && loop != "position")
@@ -852,7 +923,8 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
     c.kpp_physical = physical.kpp;
     c.kpp_normalized = normalized.kpp;
   }
-  read_state_space(root, tuning::controller_state_space(c), continuous_check_frequencies(c.plant.omega_z, c.physical));
+  read_state_space(root, tuning::controller_state_space(c), continuous_check_frequencies(c.plant.omega_z, c.physical),
+                   c.structure);
   c.discrete = read_discrete(root, c, c.prewarp_rad_s);
   c.design = read_design(root.section("design"), c.plant.omega_z, c.structure);
   c.predicted = read_predicted(root.section("predicted"), c.plant.omega_z);

@@ -51,6 +51,10 @@ void JsonObject::fail(std::string_view key, const std::string& message) const {
 }
 
 void JsonObject::allow_only(std::initializer_list<std::string_view> known) const {
+  allow_only(std::span<const std::string_view>(known.begin(), known.size()));
+}
+
+void JsonObject::allow_only(std::span<const std::string_view> known) const {
   for (const auto& [key, value] : value_.items()) {
     if (std::find(known.begin(), known.end(), key) != known.end()) continue;
     std::string list;

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <span>
 #include <string_view>
 
 #include "servotwin/core/error.hpp"
@@ -23,6 +24,8 @@ class JsonObject {
 
   /// Errors unless every member is one of `known` (typos are the usual cause).
   void allow_only(std::initializer_list<std::string_view> known) const;
+  /// The same for a list built at run time (members that depend on another member).
+  void allow_only(std::span<const std::string_view> known) const;
 
   [[nodiscard]] bool has(std::string_view key) const;
   /// Finite number (required).

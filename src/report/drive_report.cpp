@@ -19,7 +19,7 @@ std::string num(double v, int digits = 4) { return detail::format_number(v, digi
 
 std::string time_or_never(double t) { return std::isfinite(t) ? num(t) : "never"; }
 
-bool position_loop(const vcnc::DriveSimulation& s) { return tuning::has_position_loop(s.structure); }
+bool position_loop(const vcnc::DriveSimulation& s) { return tuning::controls_position(s.structure); }
 
 /// What is controlled, in words, and how to read it from a sample.
 std::string controlled_name(const vcnc::DriveSimulation& s) {

@@ -69,6 +69,16 @@ struct Context {
   [[nodiscard]] double position_per_torque() const { return velocity_per_torque() / plant.omega_z; }
   /// Torque per velocity (controller gain): normalized → model units.
   [[nodiscard]] double torque_per_velocity() const { return plant.motor_inertia * plant.omega_z; }
+  /// A full-order position controller: the loop functions and indices are positions.
+  [[nodiscard]] bool position() const { return tuning::is_position_controller(controller.structure); }
+  /// The judged variable of the tracking and disturbance functions: "ω" or "φ".
+  [[nodiscard]] const char* variable() const { return position() ? "φ" : "ω"; }
+  /// Per torque of the judged outputs (velocity or position) in model units.
+  [[nodiscard]] double output_per_torque() const { return position() ? position_per_torque() : velocity_per_torque(); }
+  /// Torque per unit reference (velocity, or position: one more ωz) in model units.
+  [[nodiscard]] double torque_per_reference() const {
+    return position() ? torque_per_velocity() * plant.omega_z : torque_per_velocity();
+  }
 };
 
 /// The log grid with the `exact` frequencies inside its span added, sorted, and points closer than
@@ -499,13 +509,17 @@ Table margins_table(const Context& c) {
   t.rows.push_back({"modulus margin 1/‖S‖∞", num(i.modulus_margin, 4), ""});
   t.rows.push_back({"‖S‖∞", num(i.peak_s, 4), fmt::format("at {} Hz", num(c.to_hz(i.peak_s_omega)))});
   t.rows.push_back({"‖T‖∞", num(i.peak_t, 4), ""});
-  t.rows.push_back({"‖ωm/ω*‖∞", num(i.peak_tm, 4), ""});
-  t.rows.push_back({"‖ωl/ω*‖∞", num(i.peak_tl, 4), ""});
-  t.rows.push_back({"‖ωl/Tl‖∞ (closed loop)", num(i.peak_load_disturbance * c.velocity_per_torque(), 4),
-                    "velocity per torque (model units)"});
+  const std::string v = c.variable();
+  const char* quantity = c.position() ? "position" : "velocity";
+  t.rows.push_back({fmt::format("‖{0}m/{0}*‖∞", v), num(i.peak_tm, 4), ""});
+  t.rows.push_back({fmt::format("‖{0}l/{0}*‖∞", v), num(i.peak_tl, 4), c.position() ? "with the prefilter" : ""});
+  t.rows.push_back({fmt::format("‖{}l/Tl‖∞ (closed loop)", v), num(i.peak_load_disturbance * c.output_per_torque(), 4),
+                    fmt::format("{} per torque (model units)", quantity)});
   t.rows.push_back({"J2 = ‖(ωl/Tl) W‖∞ closed/open loop", num(i.j2, 4), "W = s/(s + ωz)"});
-  t.rows.push_back({"motor velocity bandwidth", num(c.to_hz(i.bandwidth_motor)), "Hz (−3 dB of ωm/ω*)"});
-  t.rows.push_back({"load velocity bandwidth", num(c.to_hz(i.bandwidth_load)), "Hz (−3 dB of ωl/ω*)"});
+  t.rows.push_back({fmt::format("motor {} bandwidth", quantity), num(c.to_hz(i.bandwidth_motor)),
+                    fmt::format("Hz (−3 dB of {0}m/{0}*)", v)});
+  t.rows.push_back({fmt::format("load {} bandwidth", quantity), num(c.to_hz(i.bandwidth_load)),
+                    fmt::format("Hz (−3 dB of {0}l/{0}*)", v)});
   t.rows.push_back({"controller gain at high frequency", num(i.hf_controller_gain * c.torque_per_velocity()),
                     fmt::format("torque per velocity at {} Hz (noise amplification)", num(c.to_hz(10.0 * c.plant.r)))});
   t.rows.push_back({"least closed-loop damping", num(i.min_damping, 4), ""});
@@ -517,27 +531,31 @@ std::vector<Chart> loop_charts(const Context& c, const tuning::VelocityLoop& loo
   std::vector<Complex> s(n), t(n), tm(n), tl(n), dist(n), dist_open(n), ctrl(n);
   for (std::size_t k = 0; k < n; ++k) {
     const tuning::VelocityLoop::Responses r = loop.responses(c.omega[k]);
+    // A position controller's outputs are positions: the velocity form's over jω.
+    const Complex to_output = c.position() ? 1.0 / Complex(0.0, c.omega[k]) : Complex(1.0, 0.0);
     s[k] = r.sensitivity;
     t[k] = r.complementary;
-    tm[k] = r.motor_tracking;
-    tl[k] = r.load_tracking;
-    dist[k] = r.load_from_load_torque;
-    dist_open[k] = r.open_loop_load_from_load_torque;
+    tm[k] = r.motor_tracking * to_output;
+    tl[k] = r.load_tracking * to_output;
+    dist[k] = r.load_from_load_torque * to_output;
+    dist_open[k] = r.open_loop_load_from_load_torque * to_output;
     ctrl[k] = loop.controller(c.omega[k]);
   }
   const tuning::DesignParameters& d = c.controller.design;
+  const std::string v = c.variable();
   Chart shapes = frequency_chart("Sensitivity and tracking", "magnitude [dB]");
   shapes.series.push_back({"|S|", c.hz, db_of(s)});
   shapes.series.push_back({"|T|", c.hz, db_of(t)});
-  shapes.series.push_back({"|ωm/ω*|", c.hz, db_of(tm)});
-  if (loop.has_load_tracking()) shapes.series.push_back({"|ωl/ω*|", c.hz, db_of(tl)});
+  shapes.series.push_back({fmt::format("|{0}m/{0}*|", v), c.hz, db_of(tm)});
+  if (loop.has_load_tracking()) shapes.series.push_back({fmt::format("|{0}l/{0}*|", v), c.hz, db_of(tl)});
   if (d.ms) shapes.series.push_back(flat(fmt::format("Ms = {}", num(*d.ms, 3)), c.hz, db(*d.ms)));
   if (d.mt) shapes.series.push_back(flat(fmt::format("Mt = {}", num(*d.mt, 3)), c.hz, db(*d.mt)));
   std::vector<Chart> charts{std::move(shapes)};
   if (loop.has_load()) {
-    Chart disturbance = frequency_chart("Load-torque disturbance |ωl/Tl|", "magnitude [dB, velocity per torque]");
-    disturbance.series.push_back({"closed loop", c.hz, db_of(dist, c.velocity_per_torque())});
-    disturbance.series.push_back({"open loop (no control)", c.hz, db_of(dist_open, c.velocity_per_torque())});
+    Chart disturbance = frequency_chart(fmt::format("Load-torque disturbance |{}l/Tl|", v),
+                                        fmt::format("magnitude [dB, {} per torque]", c.position() ? "position" : "velocity"));
+    disturbance.series.push_back({"closed loop", c.hz, db_of(dist, c.output_per_torque())});
+    disturbance.series.push_back({"open loop (no control)", c.hz, db_of(dist_open, c.output_per_torque())});
     charts.push_back(std::move(disturbance));
   }
   Chart controller = frequency_chart("Controller |C(jω)|", "magnitude [dB, torque per velocity]");
@@ -555,6 +573,10 @@ Section loop_section(const Context& c, const tuning::VelocityLoop& loop) {
       "reference, the load velocity per load torque (closed loop against the uncontrolled plant: J2's "
       "reference) and the feedback controller C(s). Peaks and margins are the analysis' values (grid plus "
       "refinement).";
+  if (c.position())
+    s.text += " This is a position controller (inputs φ* and φm): the loop is analysed in its velocity form (the "
+              "feedback C2/s on ωm), so S, T, the margins and C are the position loop's, and the tracking and "
+              "disturbance functions are positions (φm/φ*, φl/φ* with the reference prefilter, φl/Tl).";
   if (!loop.has_load_tracking())
     s.text += " The plant has higher modes or no two-mass realization (its shaft damping would be negative): no "
               "load-side functions.";
@@ -593,7 +615,7 @@ Section robustness_section(const Context& c, const tuning::VelocityLoop& loop,
     t.rows.push_back({"NP: ‖S‖∞/Ms", num(rob.np, 5), num(c.to_hz(rob.np_omega)), yes_no(rob.np_ok)});
     t.rows.push_back({"RP: sup(|S|/Ms + |W2 T|)", num(rob.rp, 5), num(c.to_hz(rob.rp_omega)), yes_no(rob.rp_ok)});
   }
-  if (const std::optional<double> mt = c.controller.design.mt) {
+  if (const std::optional<double> mt = c.controller.design.mt; mt && !c.position()) {
     const tuning::RobustTracking rt = tuning::robust_tracking(loop, *w2n, *mt);
     t.rows.push_back({"robust tracking (C7.13): sup |ωm/ω*|(1 + |W2|)/(1 − |W2 T|)/Mt", num(rt.value, 5),
                       num(c.to_hz(rt.omega)), yes_no(rt.ok())});
@@ -691,33 +713,37 @@ Section time_section(const Context& c, const tuning::VelocityLoop& loop,
   const TimeGrid g = time_grid(i.horizon, i.sample_time, c.options.time_points);
   std::vector<double> t(g.samples);
   for (std::size_t k = 0; k < g.samples; ++k) t[k] = c.to_seconds(static_cast<double>(k) * g.dt);
-  const tuning::ClosedLoopTransfer cl = loop.closed_loop();
+  const tuning::ClosedLoopTransfer cl =
+      c.position() ? tuning::integrated_outputs(loop.closed_loop()) : loop.closed_loop();
+  const std::string quantity = c.position() ? "position" : "velocity";
+  const std::string v = c.variable();
 
   Chart velocity;
-  velocity.title = "Velocity setpoint step";
+  velocity.title = (c.position() ? "Position" : "Velocity") + std::string(" setpoint step");
   velocity.x_label = "time [s]";
-  velocity.y_label = "velocity (unit step)";
-  velocity.series.push_back({"motor velocity ωm", t, core::step_response(cl.motor_tracking, g.dt, g.samples)});
+  velocity.y_label = quantity + " (unit step)";
+  velocity.series.push_back({"motor " + quantity + " " + v + "m", t, core::step_response(cl.motor_tracking, g.dt, g.samples)});
   if (cl.load_tracking)
-    velocity.series.push_back({"load velocity ωl", t, core::step_response(*cl.load_tracking, g.dt, g.samples)});
+    velocity.series.push_back(
+        {"load " + quantity + " " + v + "l", t, core::step_response(*cl.load_tracking, g.dt, g.samples)});
   Chart torque;
-  torque.title = "Torque command for the velocity setpoint step (per unit velocity)";
+  torque.title = "Torque command for the " + quantity + " setpoint step (per unit " + quantity + ")";
   torque.x_label = "time [s]";
   torque.y_label = "torque [model units]";
   torque.series.push_back(
-      {"torque command u", t, scaled(core::step_response(cl.effort, g.dt, g.samples), c.torque_per_velocity())});
+      {"torque command u", t, scaled(core::step_response(cl.effort, g.dt, g.samples), c.torque_per_reference())});
   s.charts = {std::move(velocity), std::move(torque)};
   if (cl.load_from_load_torque && cl.motor_from_load_torque) {
     Chart disturbance;
     disturbance.title = "Load-torque step (per unit torque)";
     disturbance.x_label = "time [s]";
-    disturbance.y_label = "velocity [model units]";
+    disturbance.y_label = quantity + " [model units]";
     disturbance.series.push_back(
-        {"load velocity ωl", t,
-         scaled(core::step_response(*cl.load_from_load_torque, g.dt, g.samples), c.velocity_per_torque())});
+        {"load " + quantity + " " + v + "l", t,
+         scaled(core::step_response(*cl.load_from_load_torque, g.dt, g.samples), c.output_per_torque())});
     disturbance.series.push_back(
-        {"motor velocity ωm", t,
-         scaled(core::step_response(*cl.motor_from_load_torque, g.dt, g.samples), c.velocity_per_torque())});
+        {"motor " + quantity + " " + v + "m", t,
+         scaled(core::step_response(*cl.motor_from_load_torque, g.dt, g.samples), c.output_per_torque())});
     s.charts.push_back(std::move(disturbance));
   }
   if (c.controller.kpp_normalized) {
@@ -768,7 +794,7 @@ Document tuning_report(const tuning::TuneResult& result, const TuningReportOptio
                              num(c.to_hz(1.0), 4), num(plant.r, 4),
                              f && f->hinf ? fmt::format("ω0S = {} Hz, γ = {}", num(c.to_hz(f->hinf->omega_0s), 4),
                                                         num(f->hinf->gamma, 4))
-                             : f ? fmt::format("kbw = {}", num(f->weights.kbw, 4))
+                             : f ? fmt::format("kbw = {}", num(f->position_weights ? f->position_weights->kbw : f->weights.kbw, 4))
                                  : fmt::format("ω* = {} Hz", num(c.to_hz(result.controller.design.omega_star), 4)));
   doc.sections.push_back(plant_section(c));
   doc.sections.push_back(design_section(c, loop.has_load_tracking()));

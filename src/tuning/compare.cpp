@@ -17,7 +17,7 @@ std::vector<StructureComparison> compare_structures(const fit::PlantModel& model
   std::vector<StructureComparison> out;
   std::optional<core::InputError> first_failure;
   for (const Structure s : structures) {
-    if (has_position_loop(s))
+    if (controls_position(s))
       throw core::InputError(core::at_field("structures"), "expected velocity-loop structures (pi, pid, lqg, hinf): " +
                                                                to_string(s) + " closes the position loop");
     StructureComparison entry;

@@ -23,20 +23,36 @@ std::string to_string(Structure structure) {
       return "lqg+p";
     case Structure::kHinf:
       return "hinf";
+    case Structure::kLqgPos:
+      return "lqg-pos";
+    case Structure::kHinfPos:
+      return "hinf-pos";
   }
   return "pi";
 }
 
 bool is_full_order(Structure structure) noexcept {
-  return structure == Structure::kLqg || structure == Structure::kLqgP || structure == Structure::kHinf;
+  return structure == Structure::kLqg || structure == Structure::kLqgP || structure == Structure::kHinf ||
+         is_position_controller(structure);
 }
 
 bool has_position_loop(Structure structure) noexcept {
   return structure == Structure::kPiP || structure == Structure::kLqgP;
 }
 
+bool is_position_controller(Structure structure) noexcept {
+  return structure == Structure::kLqgPos || structure == Structure::kHinfPos;
+}
+
+bool controls_position(Structure structure) noexcept {
+  return has_position_loop(structure) || is_position_controller(structure);
+}
+
+bool is_hinf(Structure structure) noexcept { return structure == Structure::kHinf || structure == Structure::kHinfPos; }
+
 std::optional<Structure> structure_from_string(const std::string& name) {
-  for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP, Structure::kLqg, Structure::kLqgP, Structure::kHinf}) {
+  for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP, Structure::kLqg, Structure::kLqgP, Structure::kHinf,
+                      Structure::kLqgPos, Structure::kHinfPos}) {
     if (to_string(s) == name) return s;
   }
   return std::nullopt;
@@ -69,21 +85,23 @@ core::StateSpace controller_state_space(const PidGains& g) {
   return sys;
 }
 
-core::StateSpace to_physical(const core::StateSpace& n, const PlantScales& plant) {
+core::StateSpace to_physical(const core::StateSpace& n, const PlantScales& plant, bool position_inputs) {
   const double wz = plant.omega_z, torque = plant.motor_inertia * plant.omega_z;
-  return {wz * n.A, wz * n.B, torque * n.C, torque * n.D};
+  const double input = position_inputs ? wz : 1.0;
+  return {wz * n.A, wz * input * n.B, torque * n.C, torque * input * n.D};
 }
 
 core::StateSpace controller_state_space(const Controller& c) {
   if (!is_full_order(c.structure)) return controller_state_space(c.physical);
   if (!c.full_order) throw std::invalid_argument("controller_state_space: a full-order controller without its compensator");
-  return to_physical(c.full_order->compensator, c.plant);
+  return to_physical(c.full_order->compensator, c.plant, is_position_controller(c.structure));
 }
 
 ControllerTf normalized_controller(const Controller& c) {
   if (!is_full_order(c.structure)) return pid_controller(c.normalized);
   if (!c.full_order) throw std::invalid_argument("normalized_controller: a full-order controller without its compensator");
-  return two_dof_form(c.full_order->compensator);
+  const ControllerTf tf = two_dof_form(c.full_order->compensator);
+  return is_position_controller(c.structure) ? velocity_form(tf) : tf;
 }
 
 namespace {

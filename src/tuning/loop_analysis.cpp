@@ -145,19 +145,39 @@ enum Channel : std::size_t { kS, kT, kTm, kTl, kLoadDist, kLoadDistW, kOpenW, kC
 
 Complex weight(double w) { return Complex(0.0, w) / Complex(1.0, w); }
 
-Complex channel(const VelocityLoop& loop, Channel c, double w) {
+/// A velocity output as the indices judge it: itself, or its position v/(jω) when the loop is a
+/// position controller's velocity form (AnalysisOptions::position_outputs).
+Complex judged(Complex v, double w, bool position) { return position ? v / Complex(0.0, w) : v; }
+
+Complex channel(const VelocityLoop& loop, Channel c, double w, bool position) {
   switch (c) {
     case kS: return loop.sensitivity(w);
     case kT: return loop.complementary(w);
-    case kTm: return loop.motor_tracking(w);
-    case kTl: return loop.load_tracking(w);
-    case kLoadDist: return loop.load_from_load_torque(w);
+    case kTm: return judged(loop.motor_tracking(w), w, position);
+    case kTl: return judged(loop.load_tracking(w), w, position);
+    case kLoadDist: return judged(loop.load_from_load_torque(w), w, position);
+    // J2 stays C7.8's velocity ratio: the uncontrolled load position per torque has a double
+    // integrator that W = s/(s + 1) does not remove.
     case kLoadDistW: return loop.load_from_load_torque(w) * weight(w);
     case kOpenW: return loop.open_loop_load_from_load_torque(w) * weight(w);
     case kChannels: break;
   }
   return {kNaN, kNaN};
 }
+
+/// g/s: the numerator deflated by s when its constant term vanishes (to rounding: a velocity
+/// output of a loop that holds its position), else a pole at 0 added.
+core::TransferFunction integrated(const core::TransferFunction& g) {
+  const std::span<const double> c = g.num().coefficients();
+  double largest = 0.0;
+  for (const double v : c) largest = std::max(largest, std::abs(v));
+  constexpr double kVanishing = 1e-10;
+  if (c.size() > 1 && std::abs(c.back()) <= kVanishing * largest)
+    return {core::Polynomial(std::vector<double>(c.begin(), c.end() - 1)), g.den()};
+  return {g.num(), g.den() * core::Polynomial{1.0, 0.0}};
+}
+
+
 
 /// |z| without hypot's overflow guard (the loop functions stay far from the double range), which
 /// is most of the sampling cost otherwise.
@@ -186,22 +206,27 @@ void frequency_indices(const VelocityLoop& loop, const ClosedLoopTransfer& cl, s
   ws.l.resize(n);
   std::span<double> mags(ws.mags);
   std::span<Complex> l(ws.l.data(), n);
+  const bool position = o.position_outputs;
   for (std::size_t i = 0; i < n; ++i) {
     const double w = grid[i];
     const VelocityLoop::Responses r = loop.responses(w);
+    // A position is the velocity over jω: its magnitude over ω.
+    const double to_judged = position ? 1.0 / w : 1.0;
     l[i] = r.loop_gain;
     mags[kS * n + i] = magnitude(r.sensitivity);
     mags[kT * n + i] = magnitude(r.complementary);
-    mags[kTm * n + i] = magnitude(r.motor_tracking);
-    if (tracking) mags[kTl * n + i] = magnitude(r.load_tracking);
+    mags[kTm * n + i] = magnitude(r.motor_tracking) * to_judged;
+    if (tracking) mags[kTl * n + i] = magnitude(r.load_tracking) * to_judged;
     if (!load) continue;
-    mags[kLoadDist * n + i] = magnitude(r.load_from_load_torque);
+    mags[kLoadDist * n + i] = magnitude(r.load_from_load_torque) * to_judged;
     mags[kLoadDistW * n + i] = magnitude(r.load_from_load_torque * weight(w));
     mags[kOpenW * n + i] = magnitude(r.open_loop_load_from_load_torque * weight(w));
   }
   std::array<core::PeakResult, kChannels> peaks{};
   for (std::size_t c = 0; c < channels; ++c) {
-    const std::function<Complex(double)> f = [&loop, c](double w) { return channel(loop, static_cast<Channel>(c), w); };
+    const std::function<Complex(double)> f = [&loop, c, position](double w) {
+      return channel(loop, static_cast<Channel>(c), w, position);
+    };
     peaks[c] = refined_peak(f, grid, mags.subspan(c * n, n), o.rel_tol);
   }
   out.peak_s = peaks[kS].value;
@@ -209,13 +234,13 @@ void frequency_indices(const VelocityLoop& loop, const ClosedLoopTransfer& cl, s
   out.peak_t = peaks[kT].value;
   out.peak_tm = peaks[kTm].value;
   out.modulus_margin = 1.0 / out.peak_s;
-  out.bandwidth_motor = bandwidth_from_samples([&loop](double w) { return loop.motor_tracking(w); },
+  out.bandwidth_motor = bandwidth_from_samples([&loop, position](double w) { return channel(loop, kTm, w, position); },
                                                cl.motor_tracking.dc_gain(), grid,
                                                mags.subspan(kTm * n, n));
   out.peak_tl = out.peak_load_disturbance = out.j2 = out.bandwidth_load = kNaN;
   if (tracking) {
     out.peak_tl = peaks[kTl].value;
-    out.bandwidth_load = bandwidth_from_samples([&loop](double w) { return loop.load_tracking(w); },
+    out.bandwidth_load = bandwidth_from_samples([&loop, position](double w) { return channel(loop, kTl, w, position); },
                                                 cl.load_tracking->dc_gain(), grid,
                                                 mags.subspan(kTl * n, n));
   }
@@ -231,12 +256,14 @@ void frequency_indices(const VelocityLoop& loop, const ClosedLoopTransfer& cl, s
 /// Streaming step-response indices of one output: no storage per sample.
 class StepAccumulator {
  public:
-  StepAccumulator(double final_value, double band) : final_(final_value), band_(band * std::abs(final_value)) {}
+  /// `itae_about_final`: the ITAE of y − final (a load position keeps a static twist), else of y.
+  StepAccumulator(double final_value, double band, bool itae_about_final = false)
+      : final_(final_value), band_(band * std::abs(final_value)), itae_offset_(itae_about_final ? final_value : 0.0) {}
 
   void add(std::size_t k, double t, double y, double dt) noexcept {
     max_ = std::max(max_, y);
     max_abs_ = std::max(max_abs_, std::abs(y));
-    const double ty = t * std::abs(y);
+    const double ty = t * std::abs(y - itae_offset_);
     if (k > 0) itae_ += 0.5 * dt * (previous_ty_ + ty);
     previous_ty_ = ty;
     const double excess = std::abs(y - final_) - band_;
@@ -267,6 +294,7 @@ class StepAccumulator {
  private:
   double final_;
   double band_;
+  double itae_offset_;
   double max_ = -kInf;
   double max_abs_ = 0.0;
   double itae_ = 0.0;
@@ -347,7 +375,7 @@ void time_indices(const ClosedLoopTransfer& cl, const std::vector<Complex>& visi
   if (tracking) tfs.push_back(*cl.load_tracking);
   if (load) tfs.push_back(*cl.load_from_load_torque);
   std::vector<StepAccumulator> acc;
-  for (const core::TransferFunction& g : tfs) acc.emplace_back(g.dc_gain(), o.settling_band);
+  for (const core::TransferFunction& g : tfs) acc.emplace_back(g.dc_gain(), o.settling_band, o.position_outputs);
   simulate_steps(tfs, out.sample_time, samples, acc);
   out.overshoot_motor = acc[0].overshoot();
   out.settling_time_motor = acc[0].settling_time(out.sample_time);
@@ -369,6 +397,14 @@ void mark_unstable(LoopIndices& out) {
 }
 
 }  // namespace
+
+ClosedLoopTransfer integrated_outputs(ClosedLoopTransfer cl) {
+  cl.motor_tracking = integrated(cl.motor_tracking);
+  if (cl.load_tracking) cl.load_tracking = integrated(*cl.load_tracking);
+  if (cl.motor_from_load_torque) cl.motor_from_load_torque = integrated(*cl.motor_from_load_torque);
+  if (cl.load_from_load_torque) cl.load_from_load_torque = integrated(*cl.load_from_load_torque);
+  return cl;
+}
 
 void validate(const AnalysisOptions& o) {
   detail::require_positive(o.omega_min, "omega_min", "the grid start");
@@ -432,7 +468,7 @@ double least_visible_damping(const VelocityLoop& loop, const std::vector<Complex
 LoopIndices analyse(const VelocityLoop& loop, const AnalysisOptions& options) {
   validate(options);
   LoopIndices out;
-  const ClosedLoopTransfer cl = loop.closed_loop();
+  const ClosedLoopTransfer cl = options.position_outputs ? integrated_outputs(loop.closed_loop()) : loop.closed_loop();
   out.closed_loop_poles = cl.characteristic.roots();
   const std::vector<Complex> visible = visible_poles(loop, out.closed_loop_poles);
   out.min_damping = kInf;

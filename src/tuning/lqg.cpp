@@ -319,13 +319,15 @@ ControllerTf velocity_form(const ControllerTf& position) {
 
 double prefilter_time_constant(const VelocityLoop& loop, std::span<const double> grid, double peak_limit) {
   if (!loop.has_load()) throw std::invalid_argument("prefilter_time_constant: the loop has no load side");
+  return prefilter_time_constant([&](double w) { return loop.load_tracking(w) / Complex(0.0, w); }, grid, peak_limit);
+}
+
+double prefilter_time_constant(const std::function<Complex(double)>& tracking, std::span<const double> grid,
+                               double peak_limit, double rel_tol) {
   if (!(peak_limit > 0.0)) throw std::invalid_argument("prefilter_time_constant: the peak limit must be > 0");
   const auto peak = [&](double tau) {
-    const auto f = [&](double w) {
-      const Complex jw(0.0, w);
-      return loop.load_tracking(w) / jw / (tau * jw + 1.0);
-    };
-    return core::peak_on_grid(f, grid, 1e-9).value;
+    const auto f = [&](double w) { return tracking(w) / (tau * Complex(0.0, w) + 1.0); };
+    return core::peak_on_grid(f, grid, rel_tol).value;
   };
   if (peak(0.0) <= peak_limit) return 0.0;
   double lo = 0.0, hi = 1.0;
@@ -334,7 +336,7 @@ double prefilter_time_constant(const VelocityLoop& loop, std::span<const double>
     hi *= 2.0;
     if (hi > 1e9) throw std::invalid_argument("prefilter_time_constant: no prefilter meets the limit (static gain above it?)");
   }
-  while (hi - lo > 1e-9 * hi) {
+  while (hi - lo > rel_tol * hi) {
     const double mid = 0.5 * (lo + hi);
     (peak(mid) > peak_limit ? lo : hi) = mid;
   }

@@ -211,10 +211,15 @@ std::optional<core::TransferFunction> NormalizedPlant::load() const {
                                 Polynomial{1.0, a} * Polynomial{1.0, 2.0 * zeta_p * r, r * r});
 }
 
-std::optional<core::TransferFunction> NormalizedPlant::load_estimate() const {
-  if (!higher_modes.empty() && !chain_load) return std::nullopt;
+NormalizedPlant NormalizedPlant::first_mode() const {
   NormalizedPlant first = *this;
   first.higher_modes.clear();
+  return first;
+}
+
+std::optional<core::TransferFunction> NormalizedPlant::load_estimate() const {
+  if (!higher_modes.empty() && !chain_load) return std::nullopt;
+  const NormalizedPlant first = first_mode();
   const std::optional<core::TransferFunction> two_mass = first.load();
   if (!two_mass) return std::nullopt;
   Polynomial num = two_mass->num();

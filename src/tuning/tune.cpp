@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
+#include <functional>
 #include <fmt/format.h>
 #include <limits>
 #include <map>
@@ -82,9 +84,7 @@ std::string largest_bandwidth(const NormalizedPlant& plant) {
 /// A note when the first mode's two-mass realization is not passive: its load side (the load
 /// bandwidth and peaks, the LQG's design model, the position loop) is then an estimate.
 std::optional<std::string> estimated_load_note(const NormalizedPlant& plant) {
-  NormalizedPlant first = plant;
-  first.higher_modes.clear();
-  const std::optional<FrictionTwoMass> m = two_mass_realization(first);
+  const std::optional<FrictionTwoMass> m = two_mass_realization(plant.first_mode());
   if (!m || m->passive()) return std::nullopt;
   return fmt::format("the load side is an estimate: the fit has no passive two-mass realization (antiresonance "
                      "damping {:.3g} against resonance damping {:.3g}); its exact realization needs shaft damping "
@@ -143,8 +143,18 @@ RobustnessOptions scan_robustness_options() {
   return o;
 }
 
+using Complex = std::complex<double>;
+
+/// A position controller's reference prefilter keeps the judged position free of overshoot (C7.13).
+constexpr double kNoOvershoot = 1.0;
+/// The scans rank candidates with the prefilter found to this relative tolerance.
+constexpr double kScanPrefilterTolerance = 1e-4;
+
 /// The spec evaluated on the loop WITH the HF dynamics: stability, ‖S‖∞, the tracking peak, the
-/// bandwidth, and robust performance (uncertainty.hpp) when W2 is given.
+/// bandwidth, and robust performance (uncertainty.hpp) when W2 is given. A position controller
+/// (lqg-pos, hinf-pos; its loop in velocity_form) is judged on positions: the tracking peak of
+/// φ/φ* without its prefilter (the feedback's resonance) against Mt, the bandwidth with the
+/// prefilter that keeps φ/φ* free of overshoot.
 struct SpecCheck {
   const NormalizedPlant& plant;
   const TuneOptions& options;
@@ -163,11 +173,15 @@ struct SpecCheck {
     c.stable = loop.stable();
     if (!c.stable) return c;
     c.peak_s = core::peak_on_grid([&](double w) { return loop.sensitivity(w); }, grid, 1e-4).value;
-    const bool load = loop.has_load_tracking();
-    const auto tracking = [&](double w) { return load ? loop.load_tracking(w) : loop.motor_tracking(w); };
+    const std::function<Complex(double)> tracking = judged_tracking(loop);
     c.peak_tracking = core::peak_on_grid(tracking, grid, 1e-4).value;
-    c.bandwidth = core::bandwidth(tracking, bandwidth_grid).value_or(0.0);
     c.feasible = c.peak_s <= options.ms && c.peak_tracking <= options.mt;
+    c.bandwidth = core::bandwidth(tracking, bandwidth_grid).value_or(0.0);
+    if (position() && c.feasible) {
+      const std::optional<double> tau = prefilter(tracking, kScanPrefilterTolerance);
+      c.feasible = tau.has_value();
+      if (tau) c.bandwidth = core::bandwidth(filtered(tracking, *tau), bandwidth_grid).value_or(0.0);
+    }
     if (options.min_damping) {
       c.min_damping = least_visible_damping(loop, loop.characteristic_polynomial().roots());
       c.feasible = c.feasible && c.min_damping >= *options.min_damping;
@@ -176,13 +190,44 @@ struct SpecCheck {
     return c;
   }
 
+
+  [[nodiscard]] bool position() const noexcept { return is_position_controller(options.structure); }
+
+  /// The tracking function the spec judges: the load's where the loop has one (estimated through
+  /// the chain on a modal plant), else the motor's; for a position controller as a position (the
+  /// velocity form's output over jω; 1 at DC, where its integral action holds the reference).
+  [[nodiscard]] std::function<Complex(double)> judged_tracking(const VelocityLoop& loop) const {
+    const bool load = loop.has_load_tracking();
+    const bool as_position = position();
+    return [&loop, load, as_position](double w) {
+      const Complex v = load ? loop.load_tracking(w) : loop.motor_tracking(w);
+      if (!as_position) return v;
+      return w == 0.0 ? Complex(1.0, 0.0) : v / Complex(0.0, w);
+    };
+  }
+
+  /// The prefilter time constant keeping `tracking` free of overshoot; std::nullopt when none does.
+  [[nodiscard]] std::optional<double> prefilter(const std::function<Complex(double)>& tracking, double rel_tol) const {
+    try {
+      return prefilter_time_constant(tracking, grid, kNoOvershoot, rel_tol);
+    } catch (const std::invalid_argument&) {
+      return std::nullopt;
+    }
+  }
+
+  [[nodiscard]] static std::function<Complex(double)> filtered(const std::function<Complex(double)>& tracking,
+                                                               double tau) {
+    return [tracking, tau](double w) { return tracking(w) / (tau * Complex(0.0, w) + 1.0); };
+  }
+
  private:
   /// PI/PID: RP of the disturbance type (uncertainty.hpp); lqg: RS and C7.13's robust tracking,
   /// with a margin for the scan grid's resolution: the bisections of kbw and kff end on the
   /// boundary, and the final test on the fine grid must still pass there.
   [[nodiscard]] bool robust(const VelocityLoop& loop) const {
-    // A 1-DoF loop (PI/PID, hinf): RP of the disturbance type; the 2-DoF LQG: robust tracking.
-    if (!is_full_order(options.structure) || options.structure == Structure::kHinf)
+    // A 1-DoF loop (PI/PID, hinf): RP of the disturbance type; the 2-DoF LQG: robust tracking. A
+    // position controller: RP of the disturbance type too (C7.13's tracking test is the velocity's).
+    if (!is_full_order(options.structure) || is_hinf(options.structure) || position())
       return robustness(loop, *w2, options.ms, scan_robustness_options()).rp_ok;
     constexpr double kScanGridMargin = 1e-3;
     return robust_tracking(loop, *w2, options.mt, scan_robustness_options()).value < 1.0 - kScanGridMargin;
@@ -237,7 +282,7 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Eva
       at = c.omega_star;
     }
   }
-  const bool hinf = o.structure == Structure::kHinf;
+  const bool hinf = is_hinf(o.structure);
   const bool lqg = is_full_order(o.structure) && !hinf;
   const char* parameter = lqg ? "kbw" : hinf ? "w0S" : "omega*";
   if (!std::isfinite(best_s)) {
@@ -266,8 +311,9 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Eva
                                "||S|| = {:.3g} and {:.3g} at {} = {:.3g}; relax --ms/--mt",
                                parameter, o.ms, o.mt,
                                !o.w2 ? ""
-                               : lqg ? " with robust stability and robust tracking (C7.13)"
-                                     : " with robust performance",
+                               : lqg && !is_position_controller(o.structure)
+                                   ? " with robust stability and robust tracking (C7.13)"
+                                   : " with robust performance",
                                best_s, best_t,
                                lqg ? "kbw" : hinf ? "w0S/omega_z" : "omega*/omega_z", at));
 }
@@ -383,9 +429,7 @@ struct LqgDesigner {
 /// The LQG's design model: the first mode's two-mass realization with friction, extended by the
 /// higher modes unless the user asked for the first mode alone.
 LqgModel lqg_design_model(const NormalizedPlant& plant, const TuneOptions& options) {
-  NormalizedPlant first = plant;
-  first.higher_modes.clear();
-  const std::optional<FrictionTwoMass> m = two_mass_realization(first);
+  const std::optional<FrictionTwoMass> m = two_mass_realization(plant.first_mode());
   if (!m) {
     throw InputError(at_field("--structure"),
                      to_string(options.structure) + " needs a two-mass realization, and this plant has none (its "
@@ -459,30 +503,37 @@ std::optional<double> automatic_kbw(const LqgDesigner& lqg, const SpecCheck& che
   return chosen.omega_star;
 }
 
-/// Automatic kbw; when nothing meets the spec with the options' measurement noise V, V is raised
-/// by decades (at most kMaxNoiseDecades, when allowed): C7.13's estimator has a fixed bandwidth
-/// (its weights do not scale with kbw), too high for a loop with delay, and a larger V slows it.
-void choose_kbw(const NormalizedPlant& plant, const LqgModel& model, const TuneOptions& options,
-                const SpecCheck& check, FullOrderSummary& f, TuneResult& result) {
+/// Automatic kbw, the measurement noise raised where needed (search_raising_noise).
+/// Runs the kbw search `found()` (true when some kbw met the spec); when none does, raises the
+/// Kalman filter's measurement noise `v` by decades (at most kMaxNoiseDecades, when allowed) and
+/// searches again: C7.13's estimator has a fixed bandwidth (its weights do not scale with kbw), too
+/// high for a loop with delay, and a larger V slows it. A note says so.
+template <class Search>
+void search_raising_noise(double& v, const TuneOptions& options, TuneResult& result, Search&& found) {
   constexpr int kMaxNoiseDecades = 4;
-  const double printed = f.weights.measurement_noise;
-  for (int decade = 0;; ++decade) {
-    const LqgDesigner lqg{plant, model, f.weights};
-    if (const std::optional<double> kbw = automatic_kbw(lqg, check, options.feedforward, result.scan)) {
-      f.weights.kbw = *kbw;
-      break;
-    }
+  const double printed = v;
+  for (int decade = 0; !found(); ++decade) {
     if (!options.raise_measurement_noise || decade == kMaxNoiseDecades) no_feasible_omega(result.scan, options);
-    f.weights.measurement_noise *= 10.0;
+    v *= 10.0;
   }
-  f.kbw_source = largest_bandwidth(plant) + (options.w2 ? " with ||S|| <= Ms, tracking peak <= Mt and robust tracking"
-                                                         : " with ||S|| <= Ms and tracking peak <= Mt");
-  if (f.weights.measurement_noise != printed) {
+  if (v != printed) {
     result.controller.notes.push_back(fmt::format(
         "no kbw met the spec with the Kalman filter's measurement noise V = {:g}: V raised to {:g} (a slower "
         "estimator; the estimator of C7.13's weights is too fast for this loop's delay or lags)",
-        printed, f.weights.measurement_noise));
+        printed, v));
   }
+}
+
+void choose_kbw(const NormalizedPlant& plant, const LqgModel& model, const TuneOptions& options,
+                const SpecCheck& check, FullOrderSummary& f, TuneResult& result) {
+  search_raising_noise(f.weights.measurement_noise, options, result, [&] {
+    const LqgDesigner lqg{plant, model, f.weights};
+    const std::optional<double> kbw = automatic_kbw(lqg, check, options.feedforward, result.scan);
+    if (kbw) f.weights.kbw = *kbw;
+    return kbw.has_value();
+  });
+  f.kbw_source = largest_bandwidth(plant) + (options.w2 ? " with ||S|| <= Ms, tracking peak <= Mt and robust tracking"
+                                                         : " with ||S|| <= Ms and tracking peak <= Mt");
 }
 
 std::string pole_list(const std::vector<std::complex<double>>& poles) {
@@ -501,8 +552,11 @@ std::string pole_list(const std::vector<std::complex<double>>& poles) {
 VelocityLoop finish_full_order(TuneResult& result, const TuneOptions& options, const SpecCheck& check,
                                FullOrderSummary f, const std::string& knob, const std::string& kind) {
   Controller& c = result.controller;
-  const ControllerTf tf = two_dof_form(f.compensator);
-  c.predicted = analyse(result.plant, tf);
+  const bool position = is_position_controller(options.structure);
+  const ControllerTf tf = position ? velocity_form(two_dof_form(f.compensator)) : two_dof_form(f.compensator);
+  AnalysisOptions analysis;
+  analysis.position_outputs = position;
+  c.predicted = analyse(result.plant, tf, analysis);
   if (!c.predicted.closed_loop_stable) c.notes.push_back("the loop with the known HF dynamics is UNSTABLE at this " + knob);
   if (!f.controller_stable) {
     c.notes.push_back(fmt::format("the {} is itself UNSTABLE (poles {}, normalized): the loop is stable only while "
@@ -547,6 +601,85 @@ void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& c
   if (options.structure == Structure::kLqgP) add_position_loop(c, loop, check.w2, plant);
 }
 
+// ------------------------------------------------------------------- position controllers
+
+/// C7.13's reference prefilter of a position controller: the smallest τ keeping the judged
+/// position (the load's, else the motor's) free of overshoot on the loop with the HF dynamics,
+/// put in front of the compensator's reference input (its pole joins the controller's).
+void add_prefilter(const NormalizedPlant& plant, const SpecCheck& check, FullOrderSummary& f) {
+  const VelocityLoop loop(plant, velocity_form(two_dof_form(f.compensator)));
+  if (!loop.stable()) return;  // finish_full_order says so; no prefilter can help
+  constexpr double kFinalPrefilterTolerance = 1e-9;
+  const std::optional<double> tau = check.prefilter(check.judged_tracking(loop), kFinalPrefilterTolerance);
+  if (!tau) {
+    throw InputError(at_field("--structure"),
+                     "no reference prefilter keeps the position free of overshoot (the loop's static gain exceeds 1)");
+  }
+  f.prefilter_tau = *tau;
+  if (*tau == 0.0) return;
+  f.compensator = with_prefilter(f.compensator, *tau);
+  f.controller_poles.push_back(Complex(-1.0 / *tau, 0.0));
+}
+
+/// The C7.13 position LQG of the user's weights at one kbw, and its loop (velocity form).
+struct PositionLqgDesigner {
+  const NormalizedPlant& plant;
+  const FrictionTwoMass& model;
+  PositionLqgOptions weights;
+
+  [[nodiscard]] LqgDesign design(double kbw) const {
+    PositionLqgOptions w = weights;
+    w.kbw = kbw;
+    return position_lqg(model, plant.r, w);
+  }
+  [[nodiscard]] VelocityLoop loop(const LqgDesign& d) const {
+    return VelocityLoop(plant, velocity_form(two_dof_form(d.compensator)));
+  }
+};
+
+/// The automatic kbw of the position LQG (the velocity's search without feedforward: the
+/// reference enters through the integral state), V raised by decades when nothing meets the spec.
+void choose_position_kbw(const NormalizedPlant& plant, const FrictionTwoMass& model, const TuneOptions& options,
+                         const SpecCheck& check, PositionLqgOptions& weights, FullOrderSummary& f, TuneResult& result) {
+  search_raising_noise(weights.measurement_noise, options, result, [&] {
+    const PositionLqgDesigner lqg{plant, model, weights};
+    const auto evaluate = [&](double kbw) { return check(kbw, lqg.loop(lqg.design(kbw))); };
+    result.scan.clear();
+    for (double kbw : kbw_candidates()) result.scan.push_back(evaluate(kbw));
+    const TuneResult::Candidate chosen = choose(result.scan, evaluate);
+    if (chosen.feasible) weights.kbw = chosen.omega_star;
+    return chosen.feasible;
+  });
+  f.kbw_source = largest_bandwidth(plant) + " of the position with its prefilter, " +
+                 (options.w2 ? "||S|| <= Ms, unfiltered tracking peak <= Mt and robust performance"
+                             : "||S|| <= Ms and unfiltered tracking peak <= Mt");
+}
+
+/// The lqg-pos path of tune(): kbw, the compensator of C7.13 on the first mode's two-mass
+/// realization (position_lqg has no extended model), its prefilter, analysis and robustness.
+void tune_lqg_position(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
+  const NormalizedPlant& plant = result.plant;
+  TuneOptions first_mode = options;
+  first_mode.hinf_modes = ModeHandling::kFirstMode;
+  const LqgModel model = lqg_design_model(plant, first_mode);
+  FullOrderSummary f;
+  PositionLqgOptions weights = options.lqg_position;
+  if (options.kbw) {
+    weights.kbw = *options.kbw;
+    f.kbw_source = "given";
+  } else {
+    choose_position_kbw(plant, model.two_mass, options, check, weights, f, result);
+  }
+  f.feedforward_source = "none: the position reference enters through the integral state and the prefilter";
+  const LqgDesign d = PositionLqgDesigner{plant, model.two_mass, weights}.design(weights.kbw);
+  f.position_weights = weights;
+  f.compensator = d.compensator;
+  f.controller_poles = d.controller_poles;
+  f.controller_stable = d.controller_stable;
+  add_prefilter(plant, check, f);
+  (void)finish_full_order(result, options, check, std::move(f), "kbw: choose a larger one", "LQG compensator");
+}
+
 // ------------------------------------------------------------------------------------ hinf
 
 /// w0S candidates of the automatic search (normalized), and the w0T ladder of C7.14.
@@ -571,9 +704,12 @@ struct HinfDesigner {
     w.mt = options.mt;
     w.modes = options.hinf_modes;
     w.controller_order = options.controller_order;
-    return velocity_hinf(design_plant, w);
+    return is_position_controller(options.structure) ? position_hinf(design_plant, w) : velocity_hinf(design_plant, w);
   }
-  [[nodiscard]] VelocityLoop loop(const HinfDesign& d) const { return VelocityLoop(plant, two_dof_form(d.compensator)); }
+  [[nodiscard]] VelocityLoop loop(const HinfDesign& d) const {
+    const ControllerTf tf = two_dof_form(d.compensator);
+    return VelocityLoop(plant, is_position_controller(options.structure) ? velocity_form(tf) : tf);
+  }
 };
 
 /// One w0S: the first w0T of the ladder (or the given one) whose design meets the spec; when none
@@ -616,7 +752,7 @@ HinfCandidate evaluate_hinf(const HinfDesigner& h, const SpecCheck& check, doubl
 /// What the design did with the higher modes (C7.16).
 std::string higher_modes_note(const TuneOptions& o, const std::vector<fit::Mode>& modes) {
   const std::size_t count = modes.size();
-  const bool hinf = o.structure == Structure::kHinf;
+  const bool hinf = is_hinf(o.structure);
   std::string unobservable;
   for (std::size_t i = 0; i < count; ++i)
     if (practically_unobservable(modes[i]))
@@ -636,7 +772,7 @@ std::string higher_modes_note(const TuneOptions& o, const std::vector<fit::Mode>
     return fmt::format("designed on the full model: the controller cancels the {} higher mode(s) (a notch; "
                        "C7.16 passive): disturbances at the motor still excite them{}",
                        count, except);
-  if (is_full_order(o.structure) && o.hinf_modes != ModeHandling::kFirstMode)
+  if (is_full_order(o.structure) && o.structure != Structure::kLqgPos && o.hinf_modes != ModeHandling::kFirstMode)
     return fmt::format("designed on the full model: the {} higher mode(s) extend the LQG's design model (C7.16), "
                        "unweighted, so the regulator and the Kalman filter know them", count);
   return fmt::format("designed on the first mode; {} higher mode(s) are included in every index", count);
@@ -645,9 +781,8 @@ std::string higher_modes_note(const TuneOptions& o, const std::vector<fit::Mode>
 /// The hinf path of tune(): w0S and w0T, the compensator, its analysis and robustness.
 void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
   const NormalizedPlant& plant = result.plant;
-  NormalizedPlant design_plant = plant;  // with the known HF dynamics; C7.16 decides on the modes
-  if (options.hinf_modes == ModeHandling::kFirstMode) design_plant.higher_modes.clear();
-  const HinfDesigner h{plant, design_plant, options};
+  // With the known HF dynamics; C7.16 decides on the modes.
+  const HinfDesigner h{plant, options.hinf_modes == ModeHandling::kFirstMode ? plant.first_mode() : plant, options};
   HinfSummary s;
   s.xi_v = options.xi_v;
   s.modes = plant.higher_modes.empty() ? ModeHandling::kFirstMode : options.hinf_modes;
@@ -713,6 +848,7 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
   f.compensator = d.compensator;
   f.controller_poles = d.controller_poles;
   f.controller_stable = d.controller_stable;
+  if (is_position_controller(options.structure)) add_prefilter(plant, check, f);
   (void)finish_full_order(result, options, check, std::move(f), "w0S: choose a smaller one", "H-infinity controller");
   if (!result.advice.verdict.empty()) result.controller.notes.push_back(result.advice.verdict);
 }
@@ -840,8 +976,10 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   c.design.ms = options.ms;
   c.design.mt = options.mt;
   c.design.min_damping = options.min_damping;
-  if (options.structure == Structure::kHinf) {
+  if (is_hinf(options.structure)) {
     tune_hinf(result, options, check);
+  } else if (options.structure == Structure::kLqgPos) {
+    tune_lqg_position(result, options, check);
   } else if (is_full_order(options.structure)) {
     tune_lqg(result, options, check);
   } else if (options.structure == Structure::kPid && !options.target_r) {
@@ -852,8 +990,9 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   if (!plant.higher_modes.empty()) c.notes.push_back(higher_modes_note(options, plant.higher_modes));
   // The note matters where a load side is used: the loop's load numbers, the LQG's design model or
   // the position loop (both on the first mode's realization).
-  const bool lqg = options.structure == Structure::kLqg || options.structure == Structure::kLqgP;
-  const bool uses_load = plant.load_estimate() || lqg || has_position_loop(options.structure);
+  const bool lqg = options.structure == Structure::kLqg || options.structure == Structure::kLqgP ||
+                   options.structure == Structure::kLqgPos;
+  const bool uses_load = plant.load_estimate() || lqg || controls_position(options.structure);
   if (const std::optional<std::string> note = estimated_load_note(plant); note && uses_load) c.notes.push_back(*note);
   if (options.min_damping && c.predicted.min_damping < *options.min_damping)
     c.notes.push_back(fmt::format("least closed-loop damping {:.3g} is below --min-damping {:.3g}: the given design "

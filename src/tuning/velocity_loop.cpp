@@ -28,9 +28,7 @@ void check_gains(const PidGains& g) {
 
 /// The plant without higher modes when they are not wanted, so the two-mass realization exists.
 NormalizedPlant design_plant(const NormalizedPlant& plant, bool with_higher_modes) {
-  NormalizedPlant p = plant;
-  if (!with_higher_modes) p.higher_modes.clear();
-  return p;
+  return with_higher_modes ? plant : plant.first_mode();
 }
 
 /// The loop algebra assumes one proper controller denominator for both paths.

@@ -37,6 +37,13 @@ void check_settings(const DriveSimulationSettings& s) {
 
 bool is_position_loop(const tuning::Controller& c) { return tuning::has_position_loop(c.structure); }
 
+/// A position controller settles within its analysis horizon, which judges positions; its
+/// prefilter (C7.13) adds a few of its time constants.
+double position_controller_duration(const tuning::Controller& c) {
+  const double tau = c.full_order ? c.full_order->prefilter_tau / c.plant.omega_z : 0.0;
+  return kPositionTimeConstants * tau;
+}
+
 /// The measured output must be a motor-side signal: the cascade feeds back the motor.
 void check_plant(const machine::PlantConfig& plant, const tuning::Controller& controller, DriveTest test) {
   const auto output = plant.settings.output;
@@ -116,8 +123,15 @@ struct LoopRun {
 
 double reference_of(DriveTest test, double amplitude) { return test == DriveTest::kSetpointStep ? amplitude : 0.0; }
 
+/// What the discrete controller reads: [ω*, ωm] (velocity loop, with ω* = kpp (φ* − φm) under a P
+/// position loop) or [φ*, φm] (a full-order position controller).
+struct ControllerInputs {
+  std::optional<double> kpp;
+  bool position = false;
+};
+
 LoopRun run_loop(const machine::PlantConfig& config, const core::DiscreteStateSpace& controller,
-                 std::optional<double> kpp, DriveTest test, double amplitude, std::size_t steps,
+                 ControllerInputs inputs, DriveTest test, double amplitude, std::size_t steps,
                  std::optional<double> limit) {
   machine::FlexiblePlant plant(config);
   const double ts = plant.ts();
@@ -134,8 +148,10 @@ LoopRun run_loop(const machine::PlantConfig& config, const core::DiscreteStateSp
   run.samples.reserve(steps);
   for (std::size_t k = 0; k < steps; ++k) {
     feedback.read(m.y);
-    const double omega_ref = kpp ? *kpp * (reference - feedback.position()) : reference;
-    const double u = velocity_controller.update(omega_ref, feedback.velocity());
+    const double u =
+        inputs.position ? velocity_controller.update(reference, feedback.position())
+                        : velocity_controller.update(inputs.kpp ? *inputs.kpp * (reference - feedback.position()) : reference,
+                                                     feedback.velocity());
     run.limited += velocity_controller.limited() ? 1 : 0;
     DriveSample s;
     s.t = static_cast<double>(k) * ts;
@@ -249,6 +265,7 @@ bool settled(const DriveMetrics& m, DriveTest test) {
 double automatic_duration(const tuning::Controller& c, double ts) {
   double duration = c.predicted.horizon / c.plant.omega_z;
   if (is_position_loop(c)) duration = std::max(duration, kPositionTimeConstants / *c.kpp_physical);
+  if (tuning::is_position_controller(c.structure)) duration = std::max(duration, position_controller_duration(c));
   if (!std::isfinite(duration) || duration <= 0.0) duration = 0.0;
   return std::max(duration, static_cast<double>(kMinSamples) * ts);
 }
@@ -300,7 +317,7 @@ bool has_load_torque_input(const machine::PlantConfig& plant) noexcept {
 }
 
 ControlledVariable controlled_variable(const DriveSimulation& simulation) noexcept {
-  return {tuning::has_position_loop(simulation.structure), simulation.load_side};
+  return {tuning::controls_position(simulation.structure), simulation.load_side};
 }
 
 machine::PlantConfig linear_part(const machine::PlantConfig& plant) {
@@ -334,12 +351,13 @@ DriveSimulation simulate_drive(const machine::PlantConfig& plant, const tuning::
   compare_scales(plant, controller, out.notes);
   out.controller = tuning::discretize_controller(controller, out.ts, usable_prewarp(controller, out.ts, out.notes));
 
-  const std::optional<double> kpp = is_position_loop(controller) ? controller.kpp_physical : std::nullopt;
-  out.kpp = kpp;
+  const ControllerInputs inputs{is_position_loop(controller) ? controller.kpp_physical : std::nullopt,
+                                tuning::is_position_controller(controller.structure)};
+  out.kpp = inputs.kpp;
   const Selector select = controlled_variable(out);
   const machine::PlantConfig linear_plant = linear_part(plant);
   const auto run_linear = [&](std::size_t steps) {
-    return run_loop(linear_plant, out.controller, kpp, settings.test, settings.amplitude, steps, std::nullopt);
+    return run_loop(linear_plant, out.controller, inputs, settings.test, settings.amplitude, steps, std::nullopt);
   };
   const auto metrics = [&](const LoopRun& run) {
     return metrics_of(run, settings.test, settings.amplitude, select, settings.settling_band);
@@ -365,7 +383,8 @@ DriveSimulation simulate_drive(const machine::PlantConfig& plant, const tuning::
       duration *= 2.0;
     }
   }
-  LoopRun nonlinear = run_loop(plant, out.controller, kpp, settings.test, settings.amplitude, steps, settings.torque_limit);
+  LoopRun nonlinear =
+      run_loop(plant, out.controller, inputs, settings.test, settings.amplitude, steps, settings.torque_limit);
   out.metrics = metrics(nonlinear);
   out.samples = std::move(nonlinear.samples);
   out.linear_samples = std::move(linear.samples);

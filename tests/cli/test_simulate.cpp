@@ -106,6 +106,33 @@ TEST_F(Cli, TuneLqgPlusPAndSimulateAPositionStep) {
   EXPECT_NEAR(std::stod(cells[6]), 1.0, 0.01);  // motor position at the target
 }
 
+TEST_F(Cli, TuneTheFullPositionLqgAndSimulateAPositionStep) {
+  // C7.13's full-order position LQG (inputs [φ*, φm], its prefilter in front): the summary judges
+  // positions, the file names position inputs, and the simulated step brings the motor to the
+  // target (integral action on the motor position).
+  const Result t = run("tune table-5.1 --structure lqg-pos -o lqgpos.json");
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("structure lqg-pos: LQG position loop"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("reference prefilter: 1/(tau s + 1), tau = "), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("positions): stable"), std::string::npos) << t.out;
+  const std::string json = slurp(path("lqgpos.json"));
+  EXPECT_NE(json.find("\"position_reference\""), std::string::npos);
+  EXPECT_NE(json.find("\"prefilter_tau\""), std::string::npos);
+  const Result r = run("simulate --controller lqgpos.json --duration 60 -o pos.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("lqg-pos controller"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("controlled variable: load position"), std::string::npos) << r.out;
+  const auto cells = last_row(slurp(path("pos.csv")));
+  ASSERT_EQ(cells.size(), 14U);
+  // The linear twin at the target; on the plant the load sticks beyond it on its stiction and the
+  // motor creeps back against the shaft (within 2 % after 60 s).
+  EXPECT_NEAR(std::stod(cells[12]), 1.0, 1e-3);
+  EXPECT_NEAR(std::stod(cells[6]), 1.0, 0.02);
+  const Result frame = run("simulate --controller lqgpos.json --plant c7.19-frame --test frame-sequence -o f.csv");
+  EXPECT_NE(frame.status, 0);
+  EXPECT_NE(frame.err.find("closes a position loop"), std::string::npos) << frame.err;
+}
+
 TEST_F(Cli, SimulateLoadStepWithATorqueLimit) {
   ASSERT_EQ(run("tune table-5.1 -o pi.json").status, 0);
   const Result r = run("simulate --plant table-5.1 --controller pi.json --test load-step --amplitude 4 "

@@ -606,7 +606,7 @@ TEST_F(ControllerJsonErrors, SamplePeriodAndPrewarp) {
 }
 
 TEST_F(ControllerJsonErrors, StructureAndLoop) {
-  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"lqg\", \"lqg+p\" or \"hinf\"");
+  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"hinf\", \"lqg-pos\" or \"hinf-pos\"");
   expect(with([](auto& c) { c["position"]["kpp"] = 1.0; c["position"]["kpp_normalized"] = 1.0; }, Structure::kPiP),
          "position.kpp", "de-normalized");
   expect(with([](auto& c) { c["structure"] = "lqg"; }), "gains", "expected null for an \"lqg\" controller");
@@ -666,7 +666,7 @@ TEST_F(ControllerJsonErrors, LqgDocuments) {
          "velocity_reference");
   expect(edited([](auto& c) { c["design"]["omega_star"] = 0.5; }), "design.omega_star", "expected null");
   expect(edited([](auto& c) { c["gains"] = c["state_space"]; }), "gains", "expected null");
-  expect(with([](auto& c) { c["lqg"] = {{"kbw", 1.0}}; }), "lqg", "only lqg and lqg+p controllers");
+  expect(with([](auto& c) { c["lqg"] = {{"kbw", 1.0}}; }), "lqg", "only lqg, lqg+p and lqg-pos controllers");
 }
 
 TEST(ControllerJsonRoundTrip, HinfFromTheTuner) {
@@ -716,8 +716,63 @@ TEST_F(ControllerJsonErrors, HinfDocuments) {
                 c["hinf"].erase(k);
             }).message,
             "no error");
-  expect(edited([](auto& c) { c["lqg"] = c["hinf"]; }), "lqg", "only lqg and lqg+p controllers");
-  expect(with([](auto& c) { c["hinf"] = {{"omega_0s", 1.0}}; }), "hinf", "only hinf controllers");
+  expect(edited([](auto& c) { c["lqg"] = c["hinf"]; }), "lqg", "only lqg, lqg+p and lqg-pos controllers");
+  expect(with([](auto& c) { c["hinf"] = {{"omega_0s", 1.0}}; }), "hinf", "only hinf and hinf-pos controllers");
+}
+
+TEST(ControllerJsonRoundTrip, PositionControllersFromTheTuner) {
+  // lqg-pos and hinf-pos: inputs [φ*, φm], the prefilter's τ and state, the position weights of
+  // C7.13 for the LQG. The physical state space is the normalized compensator with time by ωz,
+  // torque by Im ωz and, the inputs being positions, one more ωz on B and D: a normalized position
+  // is ωz times the physical one (catalog §0: velocities unscaled, time by ωz).
+  for (const Structure structure : {Structure::kLqgPos, Structure::kHinfPos}) {
+    SCOPED_TRACE(tuning::to_string(structure));
+    const Controller c = full_order_controller(structure);
+    ASSERT_TRUE(c.full_order.has_value());
+    ASSERT_GT(c.full_order->prefilter_tau, 0.0);
+    const nlohmann::json j = controller_to_json(c, "two_mass.json");
+    const std::string section = structure == Structure::kLqgPos ? "lqg" : "hinf";
+    EXPECT_EQ(j["loop"], "position");
+    EXPECT_TRUE(j["position"].is_null());
+    EXPECT_EQ(j["state_space"]["inputs"], nlohmann::json({"position_reference", "motor_position"}));
+    EXPECT_EQ(j[section]["compensator"]["inputs"], nlohmann::json({"position_reference", "motor_position"}));
+    EXPECT_DOUBLE_EQ(j[section]["prefilter_tau"].get<double>(), c.full_order->prefilter_tau);
+    if (structure == Structure::kLqgPos) {
+      EXPECT_EQ(j["lqg"]["q"].size(), 5U);
+    }
+    const LoadedController back = parse_controller_json(j.dump(), "position.json");
+    expect_round_trip(c, back.controller);
+    EXPECT_EQ(back.controller.full_order->prefilter_tau, c.full_order->prefilter_tau);
+    const double wz = c.plant.omega_z, torque = c.plant.motor_inertia * wz;
+    const nlohmann::json& ss = j["state_space"];
+    for (const double w : {0.1 * wz, wz, 3.0 * wz}) {
+      const Eigen::MatrixXcd n = core::frequency_response(c.full_order->compensator, w / wz);
+      const Eigen::MatrixXcd physical = response(ss, std::complex<double>(0.0, w));
+      for (Eigen::Index k = 0; k < 2; ++k)
+        EXPECT_LE(std::abs(physical(0, k) - torque * wz * n(0, k)), 1e-9 * std::abs(physical(0, k))) << w;
+    }
+  }
+}
+
+TEST_F(ControllerJsonErrors, PositionControllerDocuments) {
+  static const nlohmann::json lqg = controller_to_json(full_order_controller(Structure::kLqgPos), "p.json");
+  const auto edited = [](auto edit) {
+    nlohmann::json copy = lqg;
+    edit(copy);
+    return error_of(copy.dump());
+  };
+  EXPECT_EQ(edited([](auto&) {}).message, "no error");
+  expect(edited([](auto& c) { c["lqg"]["compensator"]["inputs"] = {"velocity_reference", "motor_velocity"}; }),
+         "lqg.compensator.inputs", "[\"position_reference\",\"motor_position\"]");
+  expect(edited([](auto& c) { c["lqg"]["prefilter_tau"] = 2.0 * c["lqg"]["prefilter_tau"].template get<double>(); }),
+         "lqg.prefilter_tau", "not the prefilter");
+  expect(edited([](auto& c) { c["lqg"]["prefilter_tau"] = -1.0; }), "lqg.prefilter_tau", ">= 0");
+  expect(edited([](auto& c) { c["lqg"]["q"] = {1.0, 1.0}; }), "lqg.q", "5 state weights");
+  expect(edited([](auto& c) { c["lqg"]["q"][2] = -20.0; }), "lqg.q[2]", ">= 0");
+  expect(edited([](auto& c) { c["lqg"].erase("process_noise"); }), "lqg.process_noise", "missing");
+  expect(edited([](auto& c) { c["lqg"]["feedforward"] = 1.0; }), "lqg.feedforward", "unknown field");
+  expect(edited([](auto& c) { c["loop"] = "velocity"; }), "loop", "position loop");
+  expect(edited([](auto& c) { c["structure"] = "lqg"; }), "loop", "velocity loop");
 }
 
 TEST_F(ControllerJsonErrors, PlantDesignAndDerivedMembers) {

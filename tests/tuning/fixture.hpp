@@ -14,6 +14,7 @@
 #include "json_fixture.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/polynomial.hpp"
+#include "servotwin/core/state_space.hpp"
 #include "servotwin/core/transfer_function.hpp"
 #include "servotwin/fit/plant_model.hpp"
 
@@ -73,6 +74,23 @@ inline std::pair<double, std::complex<double>> min_damping(const core::Polynomia
 inline core::TransferFunction frictionless_tf(double r, double zeta_z) {
   return {core::Polynomial{1.0, 2.0 * zeta_z, 1.0},
           core::Polynomial{1.0, 0.0} * core::Polynomial{1.0, 2.0 * zeta_z * r * r, r * r}};
+}
+
+/// The closed loop of the position plant p (inputs [Tm, Tl], outputs [φm, φl], no feedthrough)
+/// and a position compensator k (inputs [φ*, φm], output Tm), written out here independently of
+/// the transfer-function route of VelocityLoop: inputs [φ*, Tl], outputs [φm, φl].
+inline core::StateSpace position_closed_loop_ss(const core::StateSpace& p, const core::StateSpace& k) {
+  const Eigen::Index n = p.A.rows(), m = k.A.rows();
+  const Eigen::MatrixXd bu = p.B.col(0), bt = p.B.col(1), cm = p.C.row(0);
+  core::StateSpace cl;
+  cl.A.resize(n + m, n + m);
+  cl.A << p.A + bu * k.D(0, 1) * cm, bu * k.C, k.B.col(1) * cm, k.A;
+  cl.B.resize(n + m, 2);
+  cl.B << bu * k.D(0, 0), bt, k.B.col(0), Eigen::MatrixXd::Zero(m, 1);
+  cl.C = Eigen::MatrixXd::Zero(2, n + m);
+  cl.C.leftCols(n) = p.C;
+  cl.D = Eigen::MatrixXd::Zero(2, 2);
+  return cl;
 }
 
 /// f() must throw core::InputError naming `field`, with `text` in its reason.

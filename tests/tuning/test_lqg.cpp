@@ -328,22 +328,6 @@ TEST(Lqg, FeedforwardLimitMatchesScipy) {
   }
 }
 
-/// The closed loop of the position plant and a position compensator (inputs [φ*, φm]), written out
-/// here: inputs [φ*, Tl], outputs [φm, φl].
-core::StateSpace position_closed_loop_ss(const core::StateSpace& p, const core::StateSpace& k) {
-  const Eigen::Index n = p.A.rows(), m = k.A.rows();
-  const Eigen::MatrixXd bu = p.B.col(0), bt = p.B.col(1), cm = p.C.row(0);
-  core::StateSpace cl;
-  cl.A.resize(n + m, n + m);
-  cl.A << p.A + bu * k.D(0, 1) * cm, bu * k.C, k.B.col(1) * cm, k.A;
-  cl.B.resize(n + m, 2);
-  cl.B << bu * k.D(0, 0), bt, k.B.col(0), Eigen::MatrixXd::Zero(m, 1);
-  cl.C = Eigen::MatrixXd::Zero(2, n + m);
-  cl.C.leftCols(n) = p.C;
-  cl.D = Eigen::MatrixXd::Zero(2, 2);
-  return cl;
-}
-
 TEST(Lqg, PositionPrefilterKeepsTheLoadPositionFromOvershooting) {
   // C7.13's position extras on the demo plant (r = 3, ζz = 0.01, kbw = 1): the smallest prefilter
   // 1/(τ s + 1) with ‖φl/φ*‖∞ <= 1. The velocity form's φl/φ* against the closed loop written out in
@@ -359,7 +343,7 @@ TEST(Lqg, PositionPrefilterKeepsTheLoadPositionFromOvershooting) {
   ASSERT_GT(tau, 0.0);  // without the prefilter the load position overshoots
   const core::StateSpace k = with_prefilter(d.compensator, tau);
   EXPECT_EQ(k.states(), 7);
-  const core::StateSpace cl = position_closed_loop_ss(two_mass_state_space(m, true), k);
+  const core::StateSpace cl = test::position_closed_loop_ss(two_mass_state_space(m, true), k);
   const auto load_position = [&](double w) { return core::frequency_response(cl, w, 1, 0); };
   for (const double w : {0.01, 0.3, 1.0, 2.9, 3.0, 10.0}) {
     const std::complex<double> jw(0.0, w);
@@ -368,7 +352,7 @@ TEST(Lqg, PositionPrefilterKeepsTheLoadPositionFromOvershooting) {
   }
   EXPECT_NEAR(std::abs(load_position(1e-4)), 1.0, 1e-6);  // integral action: φl → φ*
   EXPECT_NEAR(core::peak_on_grid(load_position, grid, 1e-10).value, 1.0, 1e-6);
-  const core::StateSpace shorter = position_closed_loop_ss(two_mass_state_space(m, true), with_prefilter(d.compensator, 0.9 * tau));
+  const core::StateSpace shorter = test::position_closed_loop_ss(two_mass_state_space(m, true), with_prefilter(d.compensator, 0.9 * tau));
   EXPECT_GT(core::peak_on_grid([&](double w) { return core::frequency_response(shorter, w, 1, 0); }, grid, 1e-10).value,
             1.0 + 1e-6);
 }

@@ -17,6 +17,7 @@
 #include "servotwin/core/state_space.hpp"
 #include "servotwin/fit/plant_model.hpp"
 #include "servotwin/machine/flexible_plant.hpp"
+#include "servotwin/tuning/loop_analysis.hpp"
 #include "servotwin/tuning/position_loop.hpp"
 #include "servotwin/tuning/tune.hpp"
 #include "servotwin/tuning/velocity_loop.hpp"
@@ -158,6 +159,47 @@ TEST(DriveSimulation, PositionLoopUnderALoadTorqueKeepsTheShaftTwist) {
   EXPECT_NEAR(sim.metrics.final_error, 0.5 / 3.0, 1e-3);
   EXPECT_TRUE(std::isfinite(sim.metrics.recovery_time));
   EXPECT_LT(sim.metrics.recovery_time, sim.samples.back().t);
+}
+
+/// A two-mass plant far from normalized units (Im = 2, ωz = 5 rad/s, r = 2, ζz = 0.02): a scaling
+/// slip between normalized and physical controllers would change the loop.
+machine::PlantConfig scaled_plant() {
+  machine::PlantConfig p;
+  p.name = "scaled two-mass";
+  p.model = machine::two_mass(2.0, 6.0, 150.0, 1.2);
+  p.settings.ts = kTs / 5.0;
+  return p;
+}
+
+TEST(DriveSimulation, PositionControllersFollowTheirContinuousLoopsInPhysicalUnits) {
+  // lqg-pos and hinf-pos read [φ*, φm]; de-normalized with positions scaled by ωz (to_physical),
+  // Tustin at ts, they must reproduce the continuous normalized loop's load-position step (time
+  // scaled by ωz) and, under a load torque, hold the motor at φ* with the load at the static twist
+  // −Tl/k (closed form, k = 150).
+  const auto plant = scaled_plant();
+  for (const tuning::Structure structure : {tuning::Structure::kLqgPos, tuning::Structure::kHinfPos}) {
+    SCOPED_TRACE(tuning::to_string(structure));
+    const auto r = tuned(plant, structure);
+    ASSERT_NEAR(r.controller.plant.omega_z, 5.0, 1e-9);
+    ASSERT_NEAR(r.controller.plant.motor_inertia, 2.0, 1e-9);
+    DriveSimulationSettings s;
+    s.duration_s = 30.0;
+    const DriveSimulation sim = simulate_drive(plant, r.controller, s);
+    EXPECT_TRUE(controlled_variable(sim).position);
+    const auto loop = tuning::integrated_outputs(continuous_loop(r));
+    const double dt_normalized = plant.settings.ts * r.controller.plant.omega_z;
+    const auto load = core::step_response(*loop.load_tracking, dt_normalized, sim.samples.size());
+    EXPECT_LT(max_difference(sim.samples, load, [](const DriveSample& x) { return x.load_position; }), 5e-3);
+    EXPECT_NEAR(sim.samples.back().load_position, 1.0, 1e-3);
+    EXPECT_NEAR(sim.metrics.overshoot, r.controller.predicted.overshoot, 5e-3);
+
+    s.test = DriveTest::kLoadStep;
+    s.amplitude = 3.0;
+    const DriveSimulation disturbance = simulate_drive(plant, r.controller, s);
+    EXPECT_NEAR(disturbance.samples.back().motor_position, 0.0, 1e-4);
+    EXPECT_NEAR(disturbance.samples.back().load_position, -3.0 / 150.0, 1e-4);
+    EXPECT_NEAR(disturbance.samples.back().torque_command, 3.0, 1e-3);
+  }
 }
 
 TEST(DriveSimulation, IntegralActionRemovesCoulombFrictionAtConstantVelocity) {

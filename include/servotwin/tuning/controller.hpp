@@ -13,6 +13,10 @@
 ///         full position LQG)
 ///   hinf  the H-infinity mixed-sensitivity velocity controller of C7.14 (1-DoF, K0/s; inputs
 ///         [ω*, ωm], 9 states)
+///   lqg-pos   the full-order position LQG of C7.13 (inputs [φ*, φm], 6 states) with its reference
+///             prefilter 1/(τ s + 1) (one more state)
+///   hinf-pos  the H-infinity mixed-sensitivity position controller of C7.14 (K0/s on the position
+///             error; inputs [φ*, φm]) with the same kind of prefilter
 
 #include <optional>
 #include <string>
@@ -28,15 +32,26 @@
 namespace servotwin::tuning {
 
 /// Controller structure offered by the tuner.
-enum class Structure { kPi, kPid, kPiP, kLqg, kLqgP, kHinf };
+enum class Structure { kPi, kPid, kPiP, kLqg, kLqgP, kHinf, kLqgPos, kHinfPos };
 
-/// A structure whose velocity controller is a general state space (no PID gains): lqg, lqg+p, hinf.
+/// A structure whose controller is a general state space (no PID gains): lqg, lqg+p, hinf,
+/// lqg-pos, hinf-pos.
 [[nodiscard]] bool is_full_order(Structure structure) noexcept;
 
 /// A structure with a P position loop over its velocity loop: pi+p, lqg+p.
 [[nodiscard]] bool has_position_loop(Structure structure) noexcept;
 
-/// "pi", "pid", "pi+p", "lqg", "lqg+p", "hinf".
+/// A full-order position controller (inputs [φ*, φm], no velocity loop): lqg-pos, hinf-pos.
+[[nodiscard]] bool is_position_controller(Structure structure) noexcept;
+
+/// The structure controls the position (its reference is φ*): has_position_loop or
+/// is_position_controller.
+[[nodiscard]] bool controls_position(Structure structure) noexcept;
+
+/// An H-infinity structure: hinf, hinf-pos.
+[[nodiscard]] bool is_hinf(Structure structure) noexcept;
+
+/// "pi", "pid", "pi+p", "lqg", "lqg+p", "hinf", "lqg-pos", "hinf-pos".
 [[nodiscard]] std::string to_string(Structure structure);
 /// Inverse of to_string; std::nullopt for an unknown name.
 [[nodiscard]] std::optional<Structure> structure_from_string(const std::string& name);
@@ -89,12 +104,21 @@ struct FullOrderSummary {
   std::optional<HinfSummary> hinf;    ///< hinf: the weights and gamma (absent for lqg)
   std::string kbw_source;             ///< "given", or what limited the automatic kbw
   std::string feedforward_source;     ///< "given", "none", or what limited the automatic kff
-  core::StateSpace compensator;       ///< normalized: inputs [ω*, ωm], output u (time by ωz, torque by Im ωz)
+  /// lqg-pos: the position weights used, with the chosen kbw (absent for the other structures).
+  std::optional<PositionLqgOptions> position_weights;
+  /// lqg-pos, hinf-pos: the reference prefilter's time constant (normalized; 0: none), C7.13's
+  /// smallest keeping the load position free of overshoot (‖φl/φ*‖∞ <= 1). Its state is the
+  /// compensator's first.
+  double prefilter_tau = 0.0;
+  /// normalized: inputs [ω*, ωm] (lqg-pos, hinf-pos: [φ*, φm]), output u (time by ωz, torque by
+  /// Im ωz, positions by 1/ωz)
+  core::StateSpace compensator;
   std::vector<std::complex<double>> controller_poles;  ///< normalized
   bool controller_stable = false;     ///< every compensator pole stable (the integrator excepted)
 };
 
-/// The P position loop of a pi+p design (C7.10), normalized units (gains in units of ωz).
+/// The P position loop of a pi+p design (C7.10), normalized units (gains in units of ωz); for
+/// lqg-pos and hinf-pos only the indices (the kpp fields are 0 and empty).
 struct PositionSummary {
   double kpp_nominal = 0.0;     ///< largest Kpp without overshoot of the load position (‖φl/φ*‖∞ <= 1)
   std::optional<double> kpp_rs;        ///< largest robustly stable Kpp (with W2)
@@ -116,7 +140,7 @@ struct Controller {
   DesignParameters design;
   LoopIndices predicted;                ///< velocity-loop indices, normalized units
   RobustnessSummary robustness;
-  std::optional<PositionSummary> position;           ///< pi+p, lqg+p only
+  std::optional<PositionSummary> position;           ///< pi+p, lqg+p, lqg-pos, hinf-pos only
   std::optional<core::DiscreteStateSpace> discrete;  ///< the velocity controller at the drive's period
   std::optional<double> prewarp_rad_s;               ///< Tustin prewarp frequency (physical)
   std::vector<std::string> notes;       ///< warnings and facts a user must see
@@ -128,14 +152,18 @@ struct Controller {
 
 /// A normalized velocity-loop controller (inputs [ω*, ωm], output u) in the model's units: time
 /// scaled by 1/ωz, torque by Im ωz (velocities are not scaled): A ωz, B ωz, C Im ωz, D Im ωz.
-[[nodiscard]] core::StateSpace to_physical(const core::StateSpace& normalized, const PlantScales& plant);
+/// `position_inputs` (inputs [φ*, φm]): a normalized position is ωz times the physical one (the
+/// integral of an unscaled velocity over normalized time), so B and D take one more factor ωz.
+[[nodiscard]] core::StateSpace to_physical(const core::StateSpace& normalized, const PlantScales& plant,
+                                          bool position_inputs = false);
 
 /// The controller in the model's units: the PID's realization, or the full-order compensator
 /// de-normalized. Throws std::invalid_argument for a full-order structure without its compensator.
 [[nodiscard]] core::StateSpace controller_state_space(const Controller& controller);
 
 /// The normalized velocity controller as the 2-DoF transfer functions a VelocityLoop takes: the
-/// PID's, or the full-order compensator's two_dof_form().
+/// PID's, or the full-order compensator's two_dof_form() (a position controller's in its
+/// velocity_form(): the loop's S, T and margins are then the position loop's).
 [[nodiscard]] ControllerTf normalized_controller(const Controller& controller);
 
 /// Tustin discretization of controller_state_space at the drive period ts [s] (physical gains),

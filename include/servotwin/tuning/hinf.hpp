@@ -148,7 +148,7 @@ struct HinfDesign {
                                                                 const VelocityHinfWeights& weights);
 
 /// The C7.14 position design: K = K0/s from the position error [φ*, φm] to the torque. Same errors
-/// as velocity_hinf. The tuner does not offer it yet (its loop analysis is the velocity loop's).
+/// as velocity_hinf. The tuner offers it as hinf-pos (tune.hpp).
 [[nodiscard]] HinfDesign position_hinf(const NormalizedPlant& plant, const VelocityHinfWeights& weights);
 
 }  // namespace servotwin::tuning

@@ -53,11 +53,24 @@ struct AnalysisOptions {
   double hf_gain_omega = 0.0;
   double horizon_time_constants = 15.0;  ///< simulation horizon in time constants of the slowest pole
   std::size_t max_samples = 20000;      ///< cap on the simulation samples (>= 100)
+  /// The loop is a position controller's velocity_form (lqg.hpp): its reference is φ* and the
+  /// indices judge positions, the tracking and disturbance outputs integrated once: bandwidths,
+  /// tracking peaks and step indices of φm/φ* and φl/φ*, peak_load_disturbance ‖φl/Tl‖∞ and
+  /// itae_load_step ∫ t |φl(t) − φl(∞)| dt (the load position keeps the shaft's static twist under
+  /// motor-position feedback). S, T, margins, the torque and j2 (C7.8's ratio of the weighted load
+  /// VELOCITY per torque: the uncontrolled load position has a double integrator W does not
+  /// remove) are the loop's as they are.
+  bool position_outputs = false;
 };
 
 /// Throws core::InputError naming the field ("omega_min", "grid_points", …) for options outside the
 /// ranges documented above.
 void validate(const AnalysisOptions& options);
+
+/// The closed loop of a position controller's velocity form with its outputs as positions (φm/φ*,
+/// φl/φ*, φm/Tl, φl/Tl: each divided by s, the numerator deflated where its constant term vanishes
+/// to rounding, as a loop that holds its position gives). S, T and the effort are unchanged.
+[[nodiscard]] ClosedLoopTransfer integrated_outputs(ClosedLoopTransfer closed_loop);
 
 /// The indices of one loop. Peaks are sup over the grid (refined).
 ///

@@ -32,6 +32,7 @@
 /// it is stable, as a drive commissioner must know before switching it on.
 
 #include <complex>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -131,6 +132,13 @@ struct LqgDesign {
 /// std::invalid_argument for a loop without a load side or a limit <= 0.
 [[nodiscard]] double prefilter_time_constant(const VelocityLoop& velocity_form_loop, std::span<const double> grid,
                                              double peak_limit = 1.0);
+
+/// The same for any position tracking function φ/φ* (normalized frequency; the load's, or the
+/// motor's where there is no load side), the bisection to `rel_tol` relative (the tuner's scans
+/// rank candidates at a coarser one).
+[[nodiscard]] double prefilter_time_constant(const std::function<std::complex<double>(double)>& position_tracking,
+                                             std::span<const double> grid, double peak_limit = 1.0,
+                                             double rel_tol = 1e-9);
 
 /// The compensator with the prefilter 1/(τ s + 1) on its reference input (one more state, first);
 /// τ = 0 returns it unchanged.

@@ -93,6 +93,9 @@ struct NormalizedPlant {
   /// An estimate: a motor-side fit does not say how the chain's modes share the load. std::nullopt
   /// when the first mode has no two-mass realization, or with higher modes and !chain_load.
   [[nodiscard]] std::optional<core::TransferFunction> load_estimate() const;
+  /// The plant of the first mode alone: a copy without the higher modes (the known HF dynamics
+  /// kept), whose two-mass realization the load side, the LQG and the position loop rest on.
+  [[nodiscard]] NormalizedPlant first_mode() const;
   /// The measured output per torque at normalized frequency ω, with higher modes and HF
   /// dynamics: motor(true)(jω) · hf.response(ω), times 1/(jω) for a position output. The
   /// physical response is this divided by Im·ωz (velocity) or Im·ωz² (position) at ω = ω_phys/ωz.

@@ -18,6 +18,14 @@
 /// upper end of the feasible w0S refined by bisection; analysed with the exact delay and the
 /// higher modes.
 ///
+/// lqg-pos, hinf-pos: the position controllers of C7.13 and C7.14 (inputs [φ*, φm]), searched
+/// like lqg and hinf with the loop judged on positions: ‖S‖∞ <= Ms, the tracking peak of φl/φ*
+/// (φm/φ* without a load side) <= Mt, and the bandwidth of φl/φ* through C7.13's reference
+/// prefilter 1/(τ s + 1), the smallest τ that keeps the position free of overshoot (part of the
+/// compensator). The position LQG designs on the first mode's two-mass realization; the position
+/// H-infinity treats higher modes as hinf does. The indices of the result judge positions
+/// (AnalysisOptions::position_outputs).
+///
 /// lqg: the velocity LQG of C7.13 on the first mode's two-mass realization (with its viscous
 /// friction); kbw scanned from slow (1e3) to fast (1e-4) on a log grid, each candidate with its
 /// largest feedforward kff within the spec (doubling, then bisection), the best load bandwidth
@@ -70,6 +78,8 @@ struct TuneOptions {
   std::size_t scan_points = 24;         ///< automatic ω*: candidates on the admissible range
   /// lqg: the weights of C7.13 (their kbw and feedforward are ignored: see the next two).
   VelocityLqgOptions lqg;
+  /// lqg-pos: the position weights of C7.13 (their kbw is ignored: see kbw).
+  PositionLqgOptions lqg_position;
   /// lqg: the bandwidth knob; std::nullopt: the kbw whose design, with its feedforward, has the
   /// largest load bandwidth within the spec of automatic ω* (stable with the HF dynamics, ‖S‖∞ <= Ms,
   /// tracking peak <= Mt and, with W2, robust stability and C7.13's robust tracking test).

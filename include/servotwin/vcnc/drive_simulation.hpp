@@ -14,9 +14,10 @@
 /// at the plant's ts (prewarped at the controller's prewarp frequency when it lies below Nyquist).
 ///
 /// Feedback signals: a motor_velocity plant output is the velocity feedback (the position of a
-/// pi+p loop is its trapezoidal integral); a motor_position output (an encoder) is the position
-/// feedback and its backward difference the velocity, so encoder quantization reaches the loop as
-/// a drive sees it. Load-side outputs are refused: the cascade feeds back the motor.
+/// pi+p loop or of a position controller is its trapezoidal integral); a motor_position output (an
+/// encoder) is the position feedback and its backward difference the velocity, so encoder
+/// quantization reaches the loop as a drive sees it. Load-side outputs are refused: the cascade
+/// feeds back the motor. A full-order position controller (lqg-pos, hinf-pos) reads [φ*, φm].
 ///
 /// Signs: the load torque Tl opposes the motion (Il ω̇l = T_shaft − Tl − friction), the
 /// dissertation's convention and tuning::VelocityLoop's.
@@ -38,7 +39,7 @@ namespace servotwin::vcnc {
 
 /// The test signal (C7.8's two tests).
 enum class DriveTest {
-  kSetpointStep,  ///< velocity step (pi, pid) or position step (pi+p) at t = 0
+  kSetpointStep,  ///< velocity step (pi, pid, lqg, hinf) or position step (pi+p, lqg+p, lqg-pos, hinf-pos) at t = 0
   kLoadStep,      ///< load-torque step at t = 0, reference 0
 };
 

@@ -1,0 +1,181 @@
+// The tuner's full-order position controllers, lqg-pos and hinf-pos (C7.13, C7.14): the position
+// LQG and H-infinity designs with C7.13's reference prefilter, judged on positions.
+// References: scipy's regulator and Kalman-filter poles of the C7.13 demo (tools/reference/
+// tuning_lqg_reference.py, "position" case r = 3, zeta_z = 0.01, kbw = 1), to which the
+// prefilter's pole -1/tau adds (separation principle); the closed loop of plant and compensator
+// written out in state space (test::position_closed_loop_ss), independently of the
+// transfer-function route (velocity form) the tuner analyses, for the prefilter's no-overshoot
+// boundary, the bandwidth, the step overshoot and the static twist; a brute-force kbw scan
+// evaluated here with its own spec code for the automatic search.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <vector>
+
+#include "fixture.hpp"
+#include "json_fixture.hpp"
+#include "servotwin/core/norms.hpp"
+#include "servotwin/core/state_space.hpp"
+#include "servotwin/tuning/compare.hpp"
+#include "servotwin/tuning/lqg.hpp"
+#include "servotwin/tuning/tune.hpp"
+
+namespace servotwin::tuning {
+namespace {
+// A namespace of its own: the module's test files are compiled as one translation unit.
+namespace tune_position_test {
+
+using Complex = std::complex<double>;
+
+const nlohmann::json& lqg_reference() {
+  static const nlohmann::json j = test_support::read_json_fixture("tuning/lqg_reference.json", "tuning_lqg_reference.py");
+  return j;
+}
+
+std::vector<Complex> roots_of(const nlohmann::json& pairs) {
+  std::vector<Complex> out;
+  for (const auto& p : pairs) out.push_back(test::root_of(p));
+  return out;
+}
+
+TuneOptions position_options(Structure structure) {
+  TuneOptions o;
+  o.structure = structure;
+  return o;
+}
+
+/// The normalized closed loop of plant and compensator in state space: inputs [φ*, Tl], outputs
+/// [φm, φl].
+core::StateSpace closed_loop(const NormalizedPlant& plant, const core::StateSpace& compensator) {
+  const FrictionTwoMass m = *two_mass_realization(plant);
+  return test::position_closed_loop_ss(two_mass_state_space(m, true), compensator);
+}
+
+/// Overshoot of the load position's unit step, simulated from the state space (ZOH at dt).
+double load_step_overshoot(const core::StateSpace& cl, double dt, std::size_t samples) {
+  core::StateSpace from_reference{cl.A, cl.B.col(0), cl.C.row(1), cl.D.block(1, 0, 1, 1)};
+  core::DiscreteSimulator sim(core::discretize_zoh(from_reference, dt));
+  double peak = 0.0;
+  for (std::size_t k = 0; k < samples; ++k) peak = std::max(peak, sim.step(1.0));
+  return std::max(0.0, peak - 1.0);
+}
+
+TEST(TunePosition, LqgPosAtTheDemoKbwHasScipysPolesAndItsPrefilterAtTheOvershootBoundary) {
+  const nlohmann::json& ref = lqg_reference().at("position").at(0);
+  ASSERT_EQ(ref.at("r").get<double>(), 3.0);
+  ASSERT_EQ(ref.at("bm").get<double>(), 0.0);
+  TuneOptions o = position_options(Structure::kLqgPos);
+  o.kbw = ref.at("kbw").get<double>();
+  const TuneResult result = tune(test::two_mass_model(3.0, ref.at("zeta_z").get<double>()), o);
+  const Controller& c = result.controller;
+  ASSERT_TRUE(c.full_order && c.full_order->position_weights);
+  EXPECT_EQ(c.full_order->position_weights->measurement_noise, 0.01);  // C7.13's V, not raised for a given kbw
+  const double tau = c.full_order->prefilter_tau;
+  ASSERT_GT(tau, 0.0);
+  EXPECT_EQ(c.full_order->compensator.states(), 7);  // C7.13: order 6 + prefilter
+
+  // Separation: the loop's poles are the regulator's, the estimator's and the prefilter's.
+  std::vector<Complex> expected = roots_of(ref.at("lqr_poles"));
+  for (const Complex& p : roots_of(ref.at("kf_poles"))) expected.push_back(p);
+  expected.emplace_back(-1.0 / tau, 0.0);
+  const std::vector<Complex> got = test::sorted_roots(c.predicted.closed_loop_poles), want = test::sorted_roots(expected);
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t i = 0; i < got.size(); ++i) EXPECT_LT(std::abs(got[i] - want[i]), 1e-5 * std::abs(want[i])) << i;
+
+  // The state-space route: φl/φ* peaks at exactly 1 (the prefilter's boundary), is 1 at DC and
+  // −3 dB at the predicted bandwidth; the predicted indices are positions.
+  const core::StateSpace cl = closed_loop(result.plant, c.full_order->compensator);
+  const auto load = [&](double w) { return core::frequency_response(cl, w, 1, 0); };
+  const std::vector<double> grid = core::log_space(1e-3, 1e2, 4000);
+  EXPECT_NEAR(core::peak_on_grid(load, grid, 1e-10).value, 1.0, 1e-6);
+  EXPECT_NEAR(c.predicted.peak_tl, 1.0, 1e-6);
+  EXPECT_NEAR(std::abs(load(1e-5)), 1.0, 1e-6);
+  EXPECT_NEAR(std::abs(load(c.predicted.bandwidth_load)), std::pow(10.0, -3.0 / 20.0), 1e-6);
+  // The step: overshoot of the simulated state space against the analysis' (both exact ZOH).
+  EXPECT_NEAR(load_step_overshoot(cl, c.predicted.sample_time, 20000), c.predicted.overshoot, 1e-4);
+}
+
+/// The automatic search's spec, evaluated here on its own: stable, ‖S‖∞ <= Ms and the unfiltered
+/// ‖φl/φ*‖∞ <= Mt on a dense grid; the bandwidth of φl/φ* through the smallest no-overshoot
+/// prefilter. 0 for an infeasible design.
+double brute_force_bandwidth(const NormalizedPlant& plant, const core::StateSpace& compensator, const TuneOptions& o) {
+  const VelocityLoop loop(plant, velocity_form(two_dof_form(compensator)));
+  if (!loop.stable()) return 0.0;
+  const std::vector<double> grid = core::log_space(1e-3, 1e2, 3000);
+  const auto tracking = [&](double w) { return w == 0.0 ? Complex(1.0, 0.0) : loop.load_tracking(w) / Complex(0.0, w); };
+  if (core::peak_on_grid([&](double w) { return loop.sensitivity(w); }, grid, 1e-6).value > o.ms) return 0.0;
+  if (core::peak_on_grid(tracking, grid, 1e-6).value > o.mt) return 0.0;
+  const double tau = prefilter_time_constant(tracking, grid, 1.0, 1e-6);
+  std::vector<double> from_zero{0.0};
+  from_zero.insert(from_zero.end(), grid.begin(), grid.end());
+  return core::bandwidth([&](double w) { return tracking(w) / (tau * Complex(0.0, w) + 1.0); }, from_zero).value_or(0.0);
+}
+
+TEST(TunePosition, AutomaticLqgPosHasTheLargestFilteredBandwidthOfABruteForceScan) {
+  const TuneOptions o = position_options(Structure::kLqgPos);
+  const TuneResult result = tune(test::two_mass_model(3.0, 0.01), o);
+  const Controller& c = result.controller;
+  ASSERT_TRUE(c.full_order && c.full_order->position_weights);
+  const PositionLqgOptions chosen = *c.full_order->position_weights;
+  const FrictionTwoMass m = *two_mass_realization(result.plant);
+  // The compensator is C7.13's design at the chosen kbw with its prefilter in front.
+  const core::StateSpace expected = with_prefilter(position_lqg(m, 3.0, chosen).compensator, c.full_order->prefilter_tau);
+  for (const double w : {0.05, 0.5, 2.0})
+    EXPECT_LT((core::frequency_response(c.full_order->compensator, w) - core::frequency_response(expected, w)).norm(),
+              1e-9 * core::frequency_response(expected, w).norm());
+  const double best = brute_force_bandwidth(result.plant, position_lqg(m, 3.0, chosen).compensator, o);
+  ASSERT_GT(best, 0.0);  // the tuner's choice meets the spec as evaluated here
+  EXPECT_NEAR(c.predicted.bandwidth_load, best, 1e-3 * best);
+  for (const double kbw : core::log_space(1e-4, 1e3, 43)) {
+    PositionLqgOptions w = chosen;
+    w.kbw = kbw;
+    EXPECT_LE(brute_force_bandwidth(result.plant, position_lqg(m, 3.0, w).compensator, o), best * 1.01) << kbw;
+  }
+}
+
+TEST(TunePosition, HinfPosIsTheC714PositionDesignWithItsPrefilterWithinTheSpec) {
+  const TuneOptions o = position_options(Structure::kHinfPos);
+  const TuneResult result = tune(test::two_mass_model(3.0, 0.01), o);
+  const Controller& c = result.controller;
+  ASSERT_TRUE(c.full_order && c.full_order->hinf);
+  const HinfSummary& h = *c.full_order->hinf;
+  VelocityHinfWeights w;
+  w.omega_0s = h.omega_0s;
+  w.omega_0t = h.omega_0t;
+  w.xi_v = h.xi_v;
+  w.ms = o.ms;
+  w.mt = o.mt;
+  const core::StateSpace expected = with_prefilter(position_hinf(result.plant, w).compensator, c.full_order->prefilter_tau);
+  for (const double x : {0.05, 0.5, 2.0})
+    EXPECT_LT((core::frequency_response(c.full_order->compensator, x) - core::frequency_response(expected, x)).norm(),
+              1e-6 * core::frequency_response(expected, x).norm());
+  EXPECT_GT(brute_force_bandwidth(result.plant, position_hinf(result.plant, w).compensator, o), 0.0);
+  // Judged on positions through the state-space route: no overshoot in frequency, integral
+  // action (φl → φ*), and under a load torque the motor held at φ* with the load at the static
+  // twist −Tl/k (normalized k = r² − 1 = 8).
+  const core::StateSpace cl = closed_loop(result.plant, c.full_order->compensator);
+  const std::vector<double> grid = core::log_space(1e-3, 1e2, 3000);
+  EXPECT_LE(core::peak_on_grid([&](double x) { return core::frequency_response(cl, x, 1, 0); }, grid, 1e-10).value,
+            1.0 + 1e-6);
+  EXPECT_NEAR(std::abs(core::frequency_response(cl, 1e-6, 1, 0)), 1.0, 1e-6);
+  EXPECT_NEAR(std::abs(core::frequency_response(cl, 1e-6, 0, 1)), 0.0, 1e-4);
+  EXPECT_NEAR(core::frequency_response(cl, 1e-6, 1, 1).real(), -1.0 / 8.0, 1e-4);
+  EXPECT_LE(c.predicted.peak_s, o.ms * (1.0 + 1e-3));
+  EXPECT_LE(c.predicted.peak_tl, 1.0 + 1e-6);
+}
+
+TEST(TunePosition, PositionStructuresAreRefusedWhereAVelocityLoopIsExpected) {
+  test::expect_input_error(
+      [] { (void)compare_structures(test::two_mass_model(3.0, 0.01), TuneOptions{}, {Structure::kLqgPos}); },
+      "structures", "closes the position loop");
+  EXPECT_EQ(structure_from_string("hinf-pos"), Structure::kHinfPos);
+  EXPECT_EQ(to_string(Structure::kLqgPos), "lqg-pos");
+  EXPECT_TRUE(is_full_order(Structure::kLqgPos) && controls_position(Structure::kHinfPos));
+  EXPECT_FALSE(has_position_loop(Structure::kLqgPos));
+}
+
+}  // namespace tune_position_test
+}  // namespace
+}  // namespace servotwin::tuning
