@@ -35,6 +35,7 @@ struct TuneArgs {
   double xi_v = 0.8;
   std::string modes = "active";
   std::optional<int> controller_order;
+  std::optional<double> rolloff_hz;
   bool raw_motor_velocity = false;
   std::optional<double> measurement_noise;
   std::string target_r = "2";
@@ -58,6 +59,7 @@ tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
   o.xi_v = a.xi_v;
   o.hinf_modes = *tuning::parse_mode_handling(a.modes);
   o.controller_order = a.controller_order;
+  if (a.rolloff_hz) o.rolloff_rad_s = 2.0 * std::numbers::pi * *a.rolloff_hz;
   o.lqg.raw_motor_velocity = a.raw_motor_velocity;
   if (a.measurement_noise) {
     o.lqg.measurement_noise = *a.measurement_noise;  // the user's V is kept, not raised
@@ -141,6 +143,9 @@ void print_hinf(tuning::Structure structure, const tuning::FullOrderSummary& f, 
              position && f.prefilter_tau > 0.0 ? " with the prefilter" : "", h.omega_0s, h.omega_0s * hz,
              h.omega_0s_source, h.omega_0t, h.xi_v, h.gamma, h.gamma_optimal);
   if (position) print_prefilter(f, scales);
+  if (h.rolloff)
+    fmt::print("roll-off: 1/(s/wf + 1) at the controller's output, wf = {:.4g} Hz (designed with; strictly proper)\n",
+               *h.rolloff * hz);
   if (h.modes != tuning::ModeHandling::kFirstMode)
     fmt::print("higher modes: {} (C7.16)\n", h.modes == tuning::ModeHandling::kActive
                                                  ? "designed with, damped actively (V extended, eq. 7.164)"
@@ -329,6 +334,10 @@ void register_tune(CLI::App& app, Action& selected) {
                   "check on the full model); LQG: first designs on mode 1, the others on the extended model")
       ->check(CLI::IsMember({"active", "passive", "first"}))
       ->capture_default_str();
+  cmd->add_option("--rolloff-hz", a->rolloff_hz,
+                  "H-infinity: a first-order low-pass at the controller's output with this corner [Hz], designed with: "
+                  "a strictly proper controller that rolls off above it (C7.14's is biproper: its gain stays flat at "
+                  "high frequency, amplifying sensor noise)");
   cmd->add_option("--controller-order", a->controller_order,
                   "H-infinity: reduce the controller to this many states by balanced truncation of its stable part "
                   "(the integrator and unstable poles are kept; default: its minimal realization)");

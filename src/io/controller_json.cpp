@@ -227,7 +227,8 @@ json hinf_json(const std::optional<tuning::FullOrderSummary>& f, Structure struc
               {"modes", tuning::to_string(h.modes)},
               {"full_order", h.full_order},
               {"hankel_singular_values", numbers_json(h.hankel, "hinf.hankel_singular_values")},
-              {"reduction_error_bound", finite(h.reduction_error_bound, "hinf.reduction_error_bound")}};
+              {"reduction_error_bound", finite(h.reduction_error_bound, "hinf.reduction_error_bound")},
+              {"rolloff", optional_finite(h.rolloff, "hinf.rolloff")}};
   add_compensator(out, *f, "hinf", structure);
   return out;
 }
@@ -738,7 +739,7 @@ std::optional<tuning::FullOrderSummary> read_hinf(const Section& root, Structure
   const Section s = root.section("hinf");
   std::vector<std::string_view> members{"omega_0s", "omega_0s_source", "omega_0t", "xi_v", "gamma_optimal", "gamma", "modes",
                                         "full_order", "hankel_singular_values", "reduction_error_bound",
-                                        "controller_stable", "controller_poles", "compensator"};
+                                        "controller_stable", "controller_poles", "compensator", "rolloff"};
   if (tuning::is_position_controller(structure)) members.emplace_back("prefilter_tau");
   s.object.allow_only(members);
   tuning::FullOrderSummary f;
@@ -751,6 +752,10 @@ std::optional<tuning::FullOrderSummary> read_hinf(const Section& root, Structure
   h.gamma = s.positive("gamma", "an H-infinity norm");
   if (h.gamma < h.gamma_optimal * (1.0 - 1e-9)) s.fail("gamma", "is below gamma_optimal");
   read_compensator(s, f, structure);
+  if (s.value.contains("rolloff")) {  // absent in files of 2026-11-25 and before: no roll-off
+    h.rolloff = s.nullable("rolloff");
+    if (h.rolloff && !(*h.rolloff > 0.0)) s.fail("rolloff", "expected a normalized corner frequency > 0 or null, got " + show(*h.rolloff));
+  }
   read_reduction(s, f.compensator.states(), h);
   f.hinf = h;
   return f;

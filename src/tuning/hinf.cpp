@@ -33,6 +33,7 @@ void check_weights(const VelocityHinfWeights& w) {
   detail::require_positive(w.mt, "mt", "a tracking peak limit");
   if (!(w.backoff >= 1.0 && w.backoff <= 10.0))
     throw core::InputError(core::at_field("backoff"), "expected a gamma backoff in [1, 10], got " + detail::show(w.backoff));
+  if (w.rolloff) detail::require_positive(*w.rolloff, "rolloff", "a roll-off corner frequency");
   if (w.controller_order && *w.controller_order < 1)
     throw core::InputError(core::at_field("controller_order"),
                            "expected a number of controller states >= 1, got " + std::to_string(*w.controller_order));
@@ -63,6 +64,11 @@ ExtraDynamics extra_dynamics(const NormalizedPlant& plant, const VelocityHinfWei
       e.hf_num = e.hf_num * pade.num();
       e.hf_den = e.hf_den * pade.den();
     }
+  }
+  // The roll-off filter the controller will carry at its output: designed with as a known lag.
+  if (weights.rolloff) {
+    e.hf_num = *weights.rolloff * e.hf_num;
+    e.hf_den = e.hf_den * Polynomial{1.0, *weights.rolloff};
   }
   if (weights.modes == ModeHandling::kFirstMode) return e;
   // Each higher mode with unit DC gain, as NormalizedPlant::motor() has it.
@@ -230,10 +236,23 @@ core::StateSpace compensator_transfer(HinfDesign& d, std::optional<int> order, b
   return bt.reduced;
 }
 
-/// K = K0/s as a 1-DoF law u = K (reference - measurement) with inputs [reference, measurement],
-/// balanced, with its poles.
-void add_compensator(HinfDesign& d, std::optional<int> order, bool minimal) {
-  const core::StateSpace k = core::balance_states(compensator_transfer(d, order, minimal));
+/// K followed by the roll-off F = ωf/(s + ωf) (VelocityHinfWeights::rolloff).
+core::StateSpace with_rolloff(const core::StateSpace& k, std::optional<double> rolloff) {
+  if (!rolloff) return k;
+  core::StateSpace f;
+  f.A = MatrixXd::Constant(1, 1, -*rolloff);
+  f.B = MatrixXd::Constant(1, 1, *rolloff);
+  f.C = MatrixXd::Constant(1, 1, 1.0);
+  f.D = MatrixXd::Zero(1, 1);
+  return core::series(k, f);
+}
+
+/// K = K0/s (with its roll-off) as a 1-DoF law u = K (reference - measurement) with inputs
+/// [reference, measurement], balanced, with its poles.
+void add_compensator(HinfDesign& d, const VelocityHinfWeights& weights) {
+  const core::StateSpace k = core::balance_states(
+      with_rolloff(compensator_transfer(d, weights.controller_order, weights.minimal_realization), weights.rolloff));
+  if (weights.rolloff) ++d.full_order;  // F's state, kept by every reduction
   d.compensator.A = k.A;
   d.compensator.B.resize(k.states(), 2);
   d.compensator.B << k.B, -k.B;
@@ -256,7 +275,7 @@ HinfDesign design(const NormalizedPlant& plant, const VelocityHinfWeights& weigh
   d.gamma_optimal = s.gamma_optimal;
   d.gamma = s.design.gamma;
   d.closed_loop_norm = s.closed_loop_norm;
-  add_compensator(d, weights.controller_order, weights.minimal_realization);
+  add_compensator(d, weights);
   return d;
 }
 

@@ -65,6 +65,11 @@ void validate(const TuneOptions& o) {
             fmt::format("expected w0T/omega_z > 0, got {}", *o.omega_0t));
   require(std::isfinite(o.xi_v) && o.xi_v >= kXiVMin && o.xi_v <= kXiVMax, "--xi-v",
           fmt::format("expected a damping in [0.707, 1] (catalog C7.14), got {}", o.xi_v));
+  if (o.rolloff_rad_s) {
+    require(std::isfinite(*o.rolloff_rad_s) && *o.rolloff_rad_s > 0.0, "--rolloff-hz",
+            fmt::format("expected a corner frequency > 0, got {} rad/s", *o.rolloff_rad_s));
+    require(is_hinf(o.structure), "--rolloff-hz", "a controller roll-off is offered for hinf and hinf-pos");
+  }
   if (o.controller_order)
     require(*o.controller_order >= 1, "--controller-order",
             fmt::format("expected a number of controller states >= 1, got {}", *o.controller_order));
@@ -704,6 +709,7 @@ struct HinfDesigner {
     w.mt = options.mt;
     w.modes = options.hinf_modes;
     w.controller_order = options.controller_order;
+    if (options.rolloff_rad_s) w.rolloff = *options.rolloff_rad_s / plant.omega_z;
     return is_position_controller(options.structure) ? position_hinf(design_plant, w) : velocity_hinf(design_plant, w);
   }
   [[nodiscard]] VelocityLoop loop(const HinfDesign& d) const {
@@ -786,6 +792,7 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
   HinfSummary s;
   s.xi_v = options.xi_v;
   s.modes = plant.higher_modes.empty() ? ModeHandling::kFirstMode : options.hinf_modes;
+  if (options.rolloff_rad_s) s.rolloff = *options.rolloff_rad_s / plant.omega_z;
   std::map<double, double> ladder;  // w0S -> the w0T its evaluation chose
   if (options.omega_0s) {
     s.omega_0s = *options.omega_0s;

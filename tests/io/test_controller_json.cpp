@@ -358,6 +358,19 @@ Controller full_order_controller(Structure structure) {
 
 Controller lqg_controller() { return full_order_controller(Structure::kLqg); }
 
+/// The H-infinity controller of full_order_controller with a 400 Hz roll-off.
+Controller rolled_off_hinf_controller() {
+  fit::PlantModel model;
+  model.rigid = fit::RigidKind::kIntegrator;
+  model.gain = 250.0;
+  const double wz = kTwoPi * 40.0;
+  model.modes = {{{wz, 0.01}, {3.0 * wz, 3.0 * 0.01}}};
+  tuning::TuneOptions o;
+  o.structure = Structure::kHinf;
+  o.rolloff_rad_s = kTwoPi * 400.0;
+  return tuning::tune(model, o).controller;
+}
+
 TEST(ControllerJsonRoundTrip, LqgFromTheTuner) {
   const Controller c = lqg_controller();
   ASSERT_TRUE(c.full_order.has_value());
@@ -689,6 +702,22 @@ TEST(ControllerJsonRoundTrip, HinfFromTheTuner) {
   expect_round_trip(c, back.controller);
 }
 
+TEST(ControllerJsonRoundTrip, HinfWithARollOff) {
+  // The roll-off's corner (normalized: 400 Hz / 40 Hz = 10) is written and read back; the written
+  // controller is strictly proper; files without the member read as no roll-off.
+  const Controller c = rolled_off_hinf_controller();
+  const nlohmann::json j = controller_to_json(c, "two_mass.json");
+  EXPECT_NEAR(j["hinf"]["rolloff"].get<double>(), 10.0, 1e-12);
+  EXPECT_EQ(j["state_space"]["D"][0][0].get<double>(), 0.0);
+  const LoadedController back = parse_controller_json(j.dump(), "hinf.json");
+  expect_round_trip(c, back.controller);
+  EXPECT_EQ(back.controller.full_order->hinf->rolloff, c.full_order->hinf->rolloff);
+  nlohmann::json old = controller_to_json(full_order_controller(Structure::kHinf), "two_mass.json");
+  EXPECT_TRUE(old["hinf"]["rolloff"].is_null());
+  old["hinf"].erase("rolloff");
+  EXPECT_FALSE(parse_controller_json(old.dump(), "old.json").controller.full_order->hinf->rolloff.has_value());
+}
+
 TEST_F(ControllerJsonErrors, HinfDocuments) {
   static const nlohmann::json hinf = controller_to_json(full_order_controller(Structure::kHinf), "p.json");
   const auto edited = [](auto edit) {
@@ -710,6 +739,7 @@ TEST_F(ControllerJsonErrors, HinfDocuments) {
   expect(edited([](auto& c) { c["hinf"]["hankel_singular_values"][1] = 1e9; }), "hinf.hankel_singular_values[1]",
          "descending");
   expect(edited([](auto& c) { c["hinf"]["reduction_error_bound"] = -1.0; }), "hinf.reduction_error_bound", ">= 0");
+  expect(edited([](auto& c) { c["hinf"]["rolloff"] = -3.0; }), "hinf.rolloff", "> 0 or null");
   // Files written before C7.16 (no modes, order or Hankel values) read as a first-mode design.
   EXPECT_EQ(edited([](auto& c) {
               for (const char* k : {"modes", "full_order", "hankel_singular_values", "reduction_error_bound"})

@@ -18,6 +18,7 @@
 #include "json_fixture.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/hinf.hpp"
+#include "servotwin/core/state_space.hpp"
 #include "servotwin/tuning/hinf.hpp"
 #include "servotwin/tuning/lqg.hpp"
 #include "servotwin/tuning/velocity_loop.hpp"
@@ -183,6 +184,37 @@ TEST(PositionHinf, MatchesOctaveAndRespectsTheMixedSensitivityBound) {
   }
 }
 
+TEST(VelocityHinf, RollOffIsTheDesignWithTheFilterAsAKnownLagAndTheFilterInSeries) {
+  // The roll-off F = wf/(s + wf) is designed with as a lag of the torque path. Reference: the same
+  // synthesis on the plant given a current lag tau = 1/wf (the HF-dynamics route, checked against
+  // Octave above) yields K'; the roll-off design must be F K' (and the same gamma), strictly proper.
+  const double wf = 20.0;
+  const NormalizedPlant plant = normalized_two_mass(3.0, 0.01);
+  NormalizedPlant lagged = plant;
+  lagged.hf.current_lag_s = 1.0 / wf;
+  VelocityHinfWeights w;
+  w.omega_0s = 0.6;
+  const HinfDesign reference = velocity_hinf(lagged, w);
+  w.rolloff = wf;
+  const HinfDesign d = velocity_hinf(plant, w);
+  EXPECT_NEAR(d.gamma_optimal, reference.gamma_optimal, 1e-9 * reference.gamma_optimal);
+  EXPECT_EQ(d.compensator.states(), reference.compensator.states() + 1);
+  EXPECT_EQ(d.full_order, reference.full_order + 1);
+  EXPECT_EQ(d.compensator.D.norm(), 0.0);  // strictly proper
+  for (const double x : {0.01, 0.3, 1.0, 3.0, 30.0, 300.0}) {
+    const std::complex<double> f = wf / std::complex<double>(wf, x);
+    for (Eigen::Index k = 0; k < 2; ++k) {
+      const std::complex<double> got = core::frequency_response(d.compensator, x, 0, k);
+      const std::complex<double> want = f * core::frequency_response(reference.compensator, x, 0, k);
+      EXPECT_LT(std::abs(got - want), 1e-6 * std::abs(want)) << x << " input " << k;
+    }
+  }
+  // Above wf the gain falls 20 dB per decade more than the biproper K' (which levels off).
+  const double ratio = std::abs(core::frequency_response(d.compensator, 1e4, 0, 1)) /
+                       std::abs(core::frequency_response(reference.compensator, 1e4, 0, 1));
+  EXPECT_NEAR(ratio, wf / 1e4, 1e-3 * wf / 1e4);
+}
+
 TEST(VelocityHinf, RejectsWeightsOutOfRange) {
   const NormalizedPlant plant = normalized_two_mass(3.0, 0.01);
   const auto field_of = [&](VelocityHinfWeights w) {
@@ -196,6 +228,9 @@ TEST(VelocityHinf, RejectsWeightsOutOfRange) {
   VelocityHinfWeights w;
   w.xi_v = 0.5;
   EXPECT_EQ(field_of(w), "xi_v");
+  w = {};
+  w.rolloff = 0.0;
+  EXPECT_EQ(field_of(w), "rolloff");
   w = {};
   w.omega_0s = 0.0;
   EXPECT_EQ(field_of(w), "omega_0s");

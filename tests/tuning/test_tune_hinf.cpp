@@ -273,6 +273,32 @@ TEST(TuneHinf, ControllerOrderIsKeptThroughTheSearchOrRefused) {
   test::expect_input_error([&] { (void)tune(two_mode_model(), o); }, "--controller-order", "unstable poles");
 }
 
+TEST(TuneHinf, RollOffMakesTheControllerStrictlyProperAndQuietAtHighFrequency) {
+  // --rolloff-hz: the tuner's search with the filter designed with; the controller it writes is
+  // strictly proper (D = 0), its gain at 10 r (the analysis' noise index) falls, the spec holds.
+  // Reference for the scaling: the corner in the summary is the physical one divided by omega_z.
+  const fit::PlantModel m = model(3.0, 0.01);
+  const double wz = 2.0 * std::numbers::pi * 40.0;
+  const TuneResult plain = tune(m, hinf_options());
+  TuneOptions o = hinf_options();
+  o.rolloff_rad_s = 20.0 * wz;
+  const TuneResult rolled = tune(m, o);
+  const Controller& c = rolled.controller;
+  ASSERT_TRUE(c.full_order && c.full_order->hinf && c.full_order->hinf->rolloff);
+  EXPECT_NEAR(*c.full_order->hinf->rolloff, 20.0, 1e-12);
+  EXPECT_EQ(c.full_order->compensator.D.norm(), 0.0);
+  EXPECT_EQ(controller_state_space(c).D.norm(), 0.0);
+  EXPECT_TRUE(meets_spec(c.predicted));
+  EXPECT_LT(c.predicted.hf_controller_gain, 0.5 * plain.controller.predicted.hf_controller_gain);
+  EXPECT_GT(c.predicted.bandwidth_load, 0.8 * plain.controller.predicted.bandwidth_load);
+  // Offered for the H-infinity structures only, and the corner must be a frequency.
+  o.structure = Structure::kPi;
+  test::expect_input_error([&] { (void)tune(m, o); }, "--rolloff-hz", "hinf and hinf-pos");
+  o = hinf_options();
+  o.rolloff_rad_s = -1.0;
+  test::expect_input_error([&] { (void)tune(m, o); }, "--rolloff-hz", "> 0");
+}
+
 }  // namespace tune_hinf_test
 }  // namespace
 }  // namespace servotwin::tuning

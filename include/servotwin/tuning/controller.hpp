@@ -93,6 +93,7 @@ struct HinfSummary {
   double gamma = 0.0;              ///< gamma of the controller (gamma_optimal times the backoff)
   std::string omega_0s_source;     ///< "given", or what limited the automatic w0S
   ModeHandling modes = ModeHandling::kFirstMode;  ///< how the design treated higher modes (C7.16)
+  std::optional<double> rolloff;   ///< corner of the controller's roll-off low-pass (normalized; none: biproper)
   int full_order = 0;              ///< states of K = K0/s before the reduction (the compensator has fewer)
   std::vector<double> hankel;      ///< Hankel singular values of K's stable part, descending
   double reduction_error_bound = 0.0;  ///< ||K_full - K||_inf bound of the reduction (0: none)

@@ -97,6 +97,12 @@ struct VelocityHinfWeights {
   /// false (with no controller_order): K at its full order, without the Hankel values: a search
   /// that only needs K's response saves the split and the Gramians.
   bool minimal_realization = true;
+  /// Roll-off: the corner ωf (normalized, > 0) of a low-pass F = ωf/(s + ωf) in series with the
+  /// controller's output. The synthesis runs on the plant with F in its torque path (as a known
+  /// lag: V's numerator gets its pole too), and the compensator is F·K' of that design: strictly
+  /// proper (|K(j∞)| = 0, −20 dB/decade more above ωf) where C7.14's biproper W2 leaves K
+  /// biproper. F's state is added after any reduction (controller_order counts K' only).
+  std::optional<double> rolloff;
 };
 
 /// A designed H-infinity velocity controller (normalized units).
@@ -110,7 +116,7 @@ struct HinfDesign {
   double omega_0t = 0.0;               ///< the w0T used
   std::vector<std::complex<double>> controller_poles;  ///< eig of the compensator (one integrator at 0)
   bool controller_stable = false;      ///< stable except the integrator (stable_except_integrator)
-  int full_order = 0;                  ///< states of K before any reduction (the generalized plant's + 1)
+  int full_order = 0;                  ///< states of K before any reduction (the generalized plant's + 1, + 1 for a roll-off)
   /// Hankel singular values of K's stable part (descending; what a reduction would discard), and
   /// the bound 2 sum(discarded) on ||K - K_reduced||_inf (0 when nothing was dropped).
   std::vector<double> hankel;

@@ -100,6 +100,10 @@ struct TuneOptions {
   /// mode 1 and only checks the full model. lqg/lqg+p: kFirstMode designs on mode 1, the others on
   /// the model extended by the higher modes (velocity_lqg with modes). No effect on a two-mass plant.
   ModeHandling hinf_modes = ModeHandling::kActive;
+  /// hinf, hinf-pos: a roll-off low-pass at the controller's output, its corner [rad/s, physical]
+  /// (VelocityHinfWeights::rolloff: designed with, the controller strictly proper); std::nullopt:
+  /// C7.14's biproper controller.
+  std::optional<double> rolloff_rad_s;
   /// hinf: the compensator's states after balanced truncation (the search designs every candidate
   /// at this order); std::nullopt: the minimal realization (VelocityHinfWeights::controller_order).
   std::optional<int> controller_order;
