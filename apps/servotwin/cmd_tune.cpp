@@ -137,9 +137,13 @@ void print_hinf(tuning::Structure structure, const tuning::FullOrderSummary& f, 
   const tuning::HinfSummary& h = *f.hinf;
   const double hz = scales.omega_z / kTwoPi;
   const bool position = tuning::is_position_controller(structure);
-  fmt::print("structure {}: mixed-sensitivity {} loop (C7.14, {} states{}): w0S = {:.4g} omega_z = {:.4g} Hz "
+  fmt::print("structure {}: mixed-sensitivity {} loop ({}, {} states{}): w0S = {:.4g} omega_z = {:.4g} Hz "
              "({}), w0T = {:.4g} omega_z, xi_v = {}; gamma = {:.4g} (optimum {:.4g})\n",
-             tuning::to_string(structure), position ? "position" : "velocity", f.compensator.states(),
+             tuning::to_string(structure),
+             position                             ? "position"
+             : tuning::measures_load(structure) ? "velocity, load measured"
+                                                  : "velocity",
+             tuning::measures_load(structure) ? "C7.17" : "C7.14", f.compensator.states(),
              position && f.prefilter_tau > 0.0 ? " with the prefilter" : "", h.omega_0s, h.omega_0s * hz,
              h.omega_0s_source, h.omega_0t, h.xi_v, h.gamma, h.gamma_optimal);
   if (position) print_prefilter(f, scales);
@@ -296,9 +300,10 @@ void register_tune(CLI::App& app, Action& selected) {
   cmd->add_option("--structure", a->structure,
                   "pi, pid (virtual inertia, C7.5), pi+p (P position loop over the PI), lqg (full-order velocity "
                   "LQG, C7.13), lqg+p (P position loop over the LQG), hinf (H-infinity mixed-sensitivity velocity "
-                  "loop, C7.14), lqg-pos (full-order position LQG with its reference prefilter, C7.13) or hinf-pos "
-                  "(H-infinity position loop with a reference prefilter, C7.14)")
-      ->check(CLI::IsMember({"pi", "pid", "pi+p", "lqg", "lqg+p", "hinf", "lqg-pos", "hinf-pos"}))
+                  "loop, C7.14), lqg-pos (full-order position LQG with its reference prefilter, C7.13), hinf-pos "
+                  "(H-infinity position loop with a reference prefilter, C7.14) or hinf-load (H-infinity velocity "
+                  "loop measuring the load velocity: a load encoder, C7.17)")
+      ->check(CLI::IsMember({"pi", "pid", "pi+p", "lqg", "lqg+p", "hinf", "lqg-pos", "hinf-pos", "hinf-load"}))
       ->capture_default_str();
   cmd->add_option("--zeta-star", a->zeta_star, "Damping of the assigned closed-loop pole pair")->capture_default_str();
   cmd->add_option("--omega-star", a->omega_star,
@@ -359,6 +364,7 @@ void register_tune(CLI::App& app, Action& selected) {
                "  servotwin tune table-5.1 --structure lqg --ts 0.000125 -o lqg.json --report lqg.html\n"
                "  servotwin tune table-5.1 --structure hinf --ts 0.000125 -o hinf.json\n"
                "  servotwin tune table-5.1 --structure lqg-pos --ts 0.000125 -o lqg-pos.json\n"
+               "  servotwin tune table-5.1 --structure hinf-load -o hinf-load.json\n"
                "  servotwin tune plant_model.json --delay 0.0005 --w2-num 2.6,0 --w2-den 1,15 --ms 1.6\n");
   add_tune_compare(*cmd, selected);
   cmd->callback([a, cmd, &selected] {

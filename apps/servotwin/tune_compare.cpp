@@ -40,7 +40,7 @@ std::vector<tuning::Structure> parse_structures(const std::string& text) {
     const std::size_t end = std::min(text.find(',', start), text.size());
     const std::string name = text.substr(start, end - start);
     const auto s = tuning::structure_from_string(name);
-    if (!s || tuning::controls_position(*s))
+    if (!s || tuning::controls_position(*s) || tuning::measures_load(*s))
       throw core::InputError(core::at_field("--structures"),
                              "expected a comma-separated list of pi, pid, lqg, hinf, got \"" + name + "\"");
     out.push_back(*s);

@@ -32,11 +32,17 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kRelTol = 1e-6;
 constexpr std::array<const char*, 2> kInputNames = {"velocity_reference", "motor_velocity"};
 constexpr std::array<const char*, 2> kPositionInputNames = {"position_reference", "motor_position"};
+constexpr std::array<const char*, 2> kLoadInputNames = {"velocity_reference", "load_velocity"};
 
-/// The controller's inputs: [ω*, ωm], or [φ*, φm] for a full-order position controller.
+/// The controller's inputs: [ω*, ωm], [φ*, φm] for a full-order position controller, [ω*, ωl] for a
+/// load-measuring one.
 const std::array<const char*, 2>& input_names(Structure s) {
+  if (tuning::measures_load(s)) return kLoadInputNames;
   return tuning::is_position_controller(s) ? kPositionInputNames : kInputNames;
 }
+
+/// What the controller measures: "motor", or "load" (C7.17).
+std::string feedback_name(Structure s) { return tuning::measures_load(s) ? "load" : "motor"; }
 
 std::string show(double v) { return fmt::format("{:.9g}", v); }
 
@@ -856,7 +862,7 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
   return {{"format", kControllerFormat},
           {"structure", to_string(c.structure)},
           {"loop", loop_name(c.structure)},
-          {"feedback", "motor"},
+          {"feedback", feedback_name(c.structure)},
           {"plant",
            {{"source", std::string(plant_source)},
             {"omega_z_hz", wz / kTwoPi},
@@ -898,7 +904,7 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
   const std::string structure = root.object.string("structure");
   const auto parsed = tuning::structure_from_string(structure);
   if (!parsed)
-    root.fail("structure", "expected \"pi\", \"pid\", \"pi+p\", \"lqg\", \"lqg+p\", \"hinf\", \"lqg-pos\" or \"hinf-pos\", got \"" +
+    root.fail("structure", "expected \"pi\", \"pid\", \"pi+p\", \"lqg\", \"lqg+p\", \"hinf\", \"lqg-pos\", \"hinf-pos\" or \"hinf-load\", got \"" +
                                structure + "\"");
   c.structure = *parsed;
   const std::string loop = root.object.string("loop");
@@ -907,7 +913,7 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
   if (loop != loop_name(c.structure))
     root.fail("loop", "a \"" + structure + "\" controller closes the " + loop_name(c.structure) + " loop, got \"" +
                           loop + "\"");
-  root.expect_string("feedback", "motor");
+  root.expect_string("feedback", feedback_name(c.structure));
 
   c.plant = read_plant(root.section("plant"), out.plant_source);
   if (tuning::is_full_order(c.structure)) {

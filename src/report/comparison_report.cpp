@@ -301,7 +301,7 @@ Document comparison_report(const std::vector<StructureComparison>& comparison, c
   for (double w : c.omega) c.hz.push_back(w * plant.omega_z / kTwoPi);
   for (const StructureComparison& e : comparison) {
     if (!e.result) continue;
-    c.designs.push_back({e, *e.result, tuning::VelocityLoop(e.result->plant, tuning::normalized_controller(e.result->controller))});
+    c.designs.push_back({e, *e.result, tuning::controller_loop(e.result->plant, e.result->controller)});
   }
   Document doc;
   doc.title = "servotwin tune compare: controller structures";

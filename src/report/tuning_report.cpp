@@ -573,6 +573,9 @@ Section loop_section(const Context& c, const tuning::VelocityLoop& loop) {
       "reference, the load velocity per load torque (closed loop against the uncontrolled plant: J2's "
       "reference) and the feedback controller C(s). Peaks and margins are the analysis' values (grid plus "
       "refinement).";
+  if (tuning::measures_load(c.controller.structure))
+    s.text += " The controller measures the LOAD velocity (C7.17): L = C·Pl, so S, T and the margins are those of the "
+              "load loop; the load-torque response of ωl is its open-loop one times S.";
   if (c.position())
     s.text += " This is a position controller (inputs φ* and φm): the loop is analysed in its velocity form (the "
               "feedback C2/s on ωm), so S, T, the margins and C are the position loop's, and the tracking and "
@@ -645,7 +648,7 @@ Section robustness_section(const Context& c, const tuning::VelocityLoop& loop,
 /// load side, else the first mode's two-mass loop).
 tuning::VelocityLoop position_base(const Context& c, const tuning::VelocityLoop& loop) {
   if (loop.has_load()) return loop;
-  return tuning::VelocityLoop(c.plant, tuning::normalized_controller(c.controller), true, false);
+  return tuning::controller_loop(c.plant, c.controller, true, false);
 }
 
 Section position_section(const Context& c, const tuning::VelocityLoop& base,
@@ -786,7 +789,7 @@ Document tuning_report(const tuning::TuneResult& result, const TuningReportOptio
   c.hz.reserve(c.omega.size());
   for (double w : c.omega) c.hz.push_back(c.to_hz(w));
 
-  const tuning::VelocityLoop loop(plant, tuning::normalized_controller(result.controller));
+  const tuning::VelocityLoop loop = tuning::controller_loop(plant, result.controller);
   Document doc;
   doc.title = "servotwin tune: " + tuning::to_string(result.controller.structure) + " controller";
   const auto& f = result.controller.full_order;

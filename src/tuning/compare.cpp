@@ -17,9 +17,10 @@ std::vector<StructureComparison> compare_structures(const fit::PlantModel& model
   std::vector<StructureComparison> out;
   std::optional<core::InputError> first_failure;
   for (const Structure s : structures) {
-    if (controls_position(s))
-      throw core::InputError(core::at_field("structures"), "expected velocity-loop structures (pi, pid, lqg, hinf): " +
-                                                               to_string(s) + " closes the position loop");
+    if (controls_position(s) || measures_load(s))
+      throw core::InputError(core::at_field("structures"),
+                             "expected motor-feedback velocity-loop structures (pi, pid, lqg, hinf): " + to_string(s) +
+                                 (measures_load(s) ? " measures the load" : " closes the position loop"));
     StructureComparison entry;
     entry.structure = s;
     TuneOptions o = options;

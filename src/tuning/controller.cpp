@@ -27,13 +27,15 @@ std::string to_string(Structure structure) {
       return "lqg-pos";
     case Structure::kHinfPos:
       return "hinf-pos";
+    case Structure::kHinfLoad:
+      return "hinf-load";
   }
   return "pi";
 }
 
 bool is_full_order(Structure structure) noexcept {
   return structure == Structure::kLqg || structure == Structure::kLqgP || structure == Structure::kHinf ||
-         is_position_controller(structure);
+         structure == Structure::kHinfLoad || is_position_controller(structure);
 }
 
 bool has_position_loop(Structure structure) noexcept {
@@ -48,11 +50,15 @@ bool controls_position(Structure structure) noexcept {
   return has_position_loop(structure) || is_position_controller(structure);
 }
 
-bool is_hinf(Structure structure) noexcept { return structure == Structure::kHinf || structure == Structure::kHinfPos; }
+bool is_hinf(Structure structure) noexcept {
+  return structure == Structure::kHinf || structure == Structure::kHinfPos || structure == Structure::kHinfLoad;
+}
+
+bool measures_load(Structure structure) noexcept { return structure == Structure::kHinfLoad; }
 
 std::optional<Structure> structure_from_string(const std::string& name) {
   for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP, Structure::kLqg, Structure::kLqgP, Structure::kHinf,
-                      Structure::kLqgPos, Structure::kHinfPos}) {
+                      Structure::kLqgPos, Structure::kHinfPos, Structure::kHinfLoad}) {
     if (to_string(s) == name) return s;
   }
   return std::nullopt;
@@ -102,6 +108,11 @@ ControllerTf normalized_controller(const Controller& c) {
   if (!c.full_order) throw std::invalid_argument("normalized_controller: a full-order controller without its compensator");
   const ControllerTf tf = two_dof_form(c.full_order->compensator);
   return is_position_controller(c.structure) ? velocity_form(tf) : tf;
+}
+
+VelocityLoop controller_loop(const NormalizedPlant& plant, const Controller& c, bool with_hf, bool with_higher_modes) {
+  if (measures_load(c.structure)) return VelocityLoop::load_feedback(plant.first_mode(), normalized_controller(c), with_hf);
+  return VelocityLoop(plant, normalized_controller(c), with_hf, with_higher_modes);
 }
 
 namespace {

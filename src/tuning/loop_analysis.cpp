@@ -433,7 +433,7 @@ void validate(const AnalysisOptions& o) {
 struct BlockRoots {
   std::vector<Complex> plant_zeros, plant_poles, controller_zeros, controller_poles;
   explicit BlockRoots(const VelocityLoop& loop)
-      : plant_zeros(loop.plant_num().roots()),
+      : plant_zeros(loop.measured_num().roots()),
         plant_poles(loop.plant_den().roots()),
         controller_zeros(loop.controller_tf().feedback.num().roots()),
         controller_poles(loop.controller_tf().feedback.den().roots()) {}
@@ -491,6 +491,10 @@ LoopIndices analyse(const NormalizedPlant& plant, const PidGains& gains, const A
 }
 
 LoopIndices analyse(const NormalizedPlant& plant, const ControllerTf& controller, const AnalysisOptions& options) {
+  return analyse(plant, VelocityLoop(plant, controller), options);
+}
+
+LoopIndices analyse(const NormalizedPlant& plant, const VelocityLoop& loop, const AnalysisOptions& options) {
   AnalysisOptions o = options;
   o.extra_frequencies.push_back(1.0);
   if (plant.r > 0.0) o.extra_frequencies.push_back(plant.r);
@@ -499,7 +503,7 @@ LoopIndices analyse(const NormalizedPlant& plant, const ControllerTf& controller
     o.extra_frequencies.push_back(m.resonance.omega_rad_s);
   }
   if (o.hf_gain_omega <= 0.0) o.hf_gain_omega = 10.0 * plant.r;
-  return analyse(VelocityLoop(plant, controller), o);
+  return analyse(loop, o);
 }
 
 

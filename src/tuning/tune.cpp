@@ -325,9 +325,15 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Eva
 
 PlantScales scales(const NormalizedPlant& p) { return {p.omega_z, p.motor_inertia, p.r, p.zeta_z, p.zeta_p, p.a}; }
 
+/// The bandwidth of the measured velocity's loop (physical): the motor's, or the load's for a
+/// load-measuring controller.
+double measured_bandwidth(const Controller& c) {
+  return (measures_load(c.structure) ? c.predicted.bandwidth_load : c.predicted.bandwidth_motor) * c.plant.omega_z;
+}
+
 /// Prewarp the Tustin map at the closed-loop bandwidth when it lies safely below Nyquist.
 std::optional<double> prewarp_frequency(const Controller& c, double ts) {
-  const double w = c.predicted.bandwidth_motor * c.plant.omega_z;
+  const double w = measured_bandwidth(c);
   if (std::isfinite(w) && w > 0.0 && w < 0.5 * std::numbers::pi / ts) return w;
   return std::nullopt;
 }
@@ -340,7 +346,7 @@ void add_discrete(Controller& c, double ts) {
                                   "its discrete pole is poorly resolved; increase --tau",
                                   c.physical.tau, ts));
   }
-  const double w_bw = c.predicted.bandwidth_motor * c.plant.omega_z;
+  const double w_bw = measured_bandwidth(c);
   if (w_bw * ts > 0.1) {
     c.notes.push_back(fmt::format("the loop bandwidth is {:.0f} % of the sampling rate: the discrete loop "
                                   "loses phase; verify with the sample delay in the HF dynamics (--delay)",
@@ -561,7 +567,10 @@ VelocityLoop finish_full_order(TuneResult& result, const TuneOptions& options, c
   const ControllerTf tf = position ? velocity_form(two_dof_form(f.compensator)) : two_dof_form(f.compensator);
   AnalysisOptions analysis;
   analysis.position_outputs = position;
-  c.predicted = analyse(result.plant, tf, analysis);
+  const VelocityLoop loop = measures_load(options.structure)
+                                ? VelocityLoop::load_feedback(result.plant, tf)
+                                : VelocityLoop(result.plant, tf);
+  c.predicted = analyse(result.plant, loop, analysis);
   if (!c.predicted.closed_loop_stable) c.notes.push_back("the loop with the known HF dynamics is UNSTABLE at this " + knob);
   if (!f.controller_stable) {
     c.notes.push_back(fmt::format("the {} is itself UNSTABLE (poles {}, normalized): the loop is stable only while "
@@ -570,7 +579,6 @@ VelocityLoop finish_full_order(TuneResult& result, const TuneOptions& options, c
                                   kind, pole_list(f.controller_poles)));
   }
   c.full_order = std::move(f);
-  VelocityLoop loop(result.plant, tf);
   if (check.w2) add_robustness(c, loop, *check.w2, options);
   return loop;
 }
@@ -710,10 +718,12 @@ struct HinfDesigner {
     w.modes = options.hinf_modes;
     w.controller_order = options.controller_order;
     if (options.rolloff_rad_s) w.rolloff = *options.rolloff_rad_s / plant.omega_z;
+    if (measures_load(options.structure)) return load_side_hinf(design_plant, w);
     return is_position_controller(options.structure) ? position_hinf(design_plant, w) : velocity_hinf(design_plant, w);
   }
   [[nodiscard]] VelocityLoop loop(const HinfDesign& d) const {
     const ControllerTf tf = two_dof_form(d.compensator);
+    if (measures_load(options.structure)) return VelocityLoop::load_feedback(plant, tf);
     return VelocityLoop(plant, is_position_controller(options.structure) ? velocity_form(tf) : tf);
   }
 };
@@ -787,6 +797,15 @@ std::string higher_modes_note(const TuneOptions& o, const std::vector<fit::Mode>
 /// The hinf path of tune(): w0S and w0T, the compensator, its analysis and robustness.
 void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
   const NormalizedPlant& plant = result.plant;
+  if (measures_load(options.structure) && (!plant.higher_modes.empty() || !two_mass_realization(plant))) {
+    throw InputError(at_field("--structure"),
+                     plant.higher_modes.empty()
+                         ? "hinf-load measures the load of the two-mass realization, and this plant has none (its shaft "
+                           "damping would be negative); use --structure hinf"
+                         : fmt::format("hinf-load (C7.17) needs a two-mass plant; this one has {} higher mode(s): use "
+                                       "--structure hinf (motor feedback, C7.16)",
+                                       plant.higher_modes.size()));
+  }
   // With the known HF dynamics; C7.16 decides on the modes.
   const HinfDesigner h{plant, options.hinf_modes == ModeHandling::kFirstMode ? plant.first_mode() : plant, options};
   HinfSummary s;
@@ -807,11 +826,13 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
     // w0T of the ladder rescues (a faster pair only raises the peaks further).
     bool met = false;
     int misses = 0;
-    for (double w : core::log_space(kOmega0sSlowest, kOmega0sFastestPerR * plant.r, kOmega0sPoints)) {
+    const double fastest = kOmega0sFastestPerR * plant.r;
+    for (double w : core::log_space(kOmega0sSlowest, fastest, kOmega0sPoints)) {
       result.scan.push_back(evaluate(w));
       met = met || result.scan.back().feasible;
       misses = result.scan.back().feasible ? 0 : misses + 1;
-      if (met && misses == 2) break;
+      // Load feedback (C7.17) has no such monotony: a band of low w0S can fail between feasible ones.
+      if (met && misses == 2 && !measures_load(options.structure)) break;
     }
     TuneResult::Candidate chosen = choose(result.scan, evaluate);
     if (!chosen.feasible) no_feasible_omega(result.scan, options);
@@ -826,6 +847,13 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
     s.omega_0s = chosen.omega_star;
     s.omega_0s_source = largest_bandwidth(plant) + (options.w2 ? " with ||S|| <= Ms, peak <= Mt and robust performance"
                                                                : " with ||S|| <= Ms and peak <= Mt");
+    if (chosen.omega_star >= fastest * (1.0 - 1e-9)) {
+      s.omega_0s_source = fmt::format("the search's end 2r = {:.4g} (the spec did not bind)", fastest);
+      result.controller.notes.push_back(fmt::format(
+          "w0S stopped at the end of its search, 2r = {:.4g} omega_z, with the spec still met{}: a faster loop costs "
+          "controller gain (noise); give --omega-0s to go further",
+          fastest, measures_load(options.structure) ? " (load feedback has no antiresonance limit, C7.17)" : ""));
+    }
   }
   if (options.omega_0t) {
     s.omega_0t = *options.omega_0t;
@@ -999,7 +1027,8 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   // the position loop (both on the first mode's realization).
   const bool lqg = options.structure == Structure::kLqg || options.structure == Structure::kLqgP ||
                    options.structure == Structure::kLqgPos;
-  const bool uses_load = plant.load_estimate() || lqg || controls_position(options.structure);
+  const bool uses_load =
+      plant.load_estimate() || lqg || controls_position(options.structure) || measures_load(options.structure);
   if (const std::optional<std::string> note = estimated_load_note(plant); note && uses_load) c.notes.push_back(*note);
   if (options.min_damping && c.predicted.min_damping < *options.min_damping)
     c.notes.push_back(fmt::format("least closed-loop damping {:.3g} is below --min-damping {:.3g}: the given design "

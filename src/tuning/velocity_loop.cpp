@@ -97,6 +97,7 @@ TransferFunction pade_delay(double delay, int order) {
 
 struct VelocityLoop::Values {
   Complex nc, dc, nr, na, da, nf, df, np, dp, delta;
+  Complex nm;  // the measured plant's numerator: np, or Pl's
 };
 
 VelocityLoop::VelocityLoop(const NormalizedPlant& plant, const PidGains& gains, bool with_hf, bool with_higher_modes,
@@ -146,6 +147,17 @@ VelocityLoop::VelocityLoop(const NormalizedPlant& plant, ControllerTf controller
   characteristic_ = characteristic(pade.num(), pade.den());
 }
 
+VelocityLoop VelocityLoop::load_feedback(const NormalizedPlant& plant, ControllerTf controller, bool with_hf,
+                                         int pade_order) {
+  VelocityLoop loop(plant, std::move(controller), with_hf, true, pade_order);
+  if (!loop.has_load_)
+    throw std::invalid_argument("VelocityLoop::load_feedback: the plant has no two-mass realization to measure the load of");
+  loop.measures_load_ = true;
+  const TransferFunction pade = pade_delay(loop.delay_, loop.pade_order_);
+  loop.characteristic_ = loop.characteristic(pade.num(), pade.den());
+  return loop;
+}
+
 double VelocityLoop::controller_hf_limit() const noexcept {
   const Polynomial& num = controller_.feedback.num();
   const Polynomial& den = controller_.feedback.den();
@@ -156,7 +168,7 @@ double VelocityLoop::controller_hf_limit() const noexcept {
 Polynomial VelocityLoop::characteristic(const Polynomial& delay_num, const Polynomial& delay_den) const {
   // The same products, in the same order, as rational(): both give the identical Δ.
   return controller_.feedback.den() * (act_den_ * delay_den) * fb_den_ * plant_den_ +
-         controller_.feedback.num() * (act_num_ * delay_num) * fb_num_ * plant_num_;
+         controller_.feedback.num() * (act_num_ * delay_num) * fb_num_ * measured_num();
 }
 
 VelocityLoop::Values VelocityLoop::values(double omega) const noexcept {
@@ -171,7 +183,8 @@ VelocityLoop::Values VelocityLoop::values(double omega) const noexcept {
   v.df = fb_den_(s);
   v.np = plant_num_(s);
   v.dp = plant_den_(s);
-  v.delta = v.dc * v.da * v.df * v.dp + v.nc * v.na * v.nf * v.np;
+  v.nm = measures_load_ ? load_num_(s) : v.np;
+  v.delta = v.dc * v.da * v.df * v.dp + v.nc * v.na * v.nf * v.nm;
   return v;
 }
 
@@ -186,7 +199,7 @@ Complex VelocityLoop::plant(double omega) const noexcept {
 
 Complex VelocityLoop::loop_gain(double omega) const noexcept {
   const Values v = values(omega);
-  return (v.nc * v.na * v.nf * v.np) / (v.dc * v.da * v.df * v.dp);
+  return (v.nc * v.na * v.nf * v.nm) / (v.dc * v.da * v.df * v.dp);
 }
 
 Complex VelocityLoop::sensitivity(double omega) const noexcept {
@@ -196,7 +209,7 @@ Complex VelocityLoop::sensitivity(double omega) const noexcept {
 
 Complex VelocityLoop::complementary(double omega) const noexcept {
   const Values v = values(omega);
-  return v.nc * v.na * v.nf * v.np / v.delta;
+  return v.nc * v.na * v.nf * v.nm / v.delta;
 }
 
 Complex VelocityLoop::motor_tracking(double omega) const noexcept {
@@ -217,17 +230,12 @@ Complex VelocityLoop::load_tracking(double omega) const noexcept {
 
 Complex VelocityLoop::motor_from_load_torque(double omega) const noexcept {
   if (!has_load_) return {kNaN, kNaN};
-  const Values v = values(omega);
-  return motor_dist_num_(Complex(0.0, omega)) * v.dc * v.da * v.df / v.delta;
+  return responses(omega).motor_from_load_torque;
 }
 
 Complex VelocityLoop::load_from_load_torque(double omega) const noexcept {
   if (!has_load_) return {kNaN, kNaN};
-  // ωl/Tl = Gll − Glm·A·C·F·Gml·S; with the two-mass identity nLl·nP − nLm·nMl = −s·dP/Il the dP
-  // cancels exactly, which keeps the value finite at ω = 0 for an integrating plant.
-  const Values v = values(omega);
-  const Complex s(0.0, omega);
-  return (load_dist_num_(s) * v.dc * v.da * v.df - s * v.nc * v.na * v.nf / load_inertia_) / v.delta;
+  return responses(omega).load_from_load_torque;
 }
 
 Complex VelocityLoop::open_loop_load_from_load_torque(double omega) const noexcept {
@@ -239,7 +247,7 @@ Complex VelocityLoop::open_loop_load_from_load_torque(double omega) const noexce
 VelocityLoop::Responses VelocityLoop::responses(double omega) const noexcept {
   const Values v = values(omega);
   const Complex s(0.0, omega);
-  const Complex open = v.nc * v.na * v.nf * v.np;
+  const Complex open = v.nc * v.na * v.nf * v.nm;
   const Complex plant_side = v.dc * v.da * v.df * v.dp;
   Responses r;
   r.loop_gain = open / plant_side;
@@ -253,8 +261,18 @@ VelocityLoop::Responses VelocityLoop::responses(double omega) const noexcept {
     return r;
   }
   const Complex load_dist = load_dist_num_(s);
-  r.motor_from_load_torque = motor_dist_num_(s) * v.dc * v.da * v.df / v.delta;
-  r.load_from_load_torque = (load_dist * v.dc * v.da * v.df - s * v.nc * v.na * v.nf / load_inertia_) / v.delta;
+  // The measured velocity's disturbance is the open one times S; the other's is the open one minus
+  // the torque's effect. With the two-mass identity nLl·nP − nLm·nMl = −s·dP/Il the dP cancels
+  // exactly, which keeps the value finite at ω = 0 for an integrating plant.
+  const Complex closed = v.dc * v.da * v.df;
+  const Complex coupling = s * v.nc * v.na * v.nf / load_inertia_;
+  if (measures_load_) {
+    r.motor_from_load_torque = (motor_dist_num_(s) * closed + coupling) / v.delta;
+    r.load_from_load_torque = load_dist * closed / v.delta;
+  } else {
+    r.motor_from_load_torque = motor_dist_num_(s) * closed / v.delta;
+    r.load_from_load_torque = (load_dist * closed - coupling) / v.delta;
+  }
   r.open_loop_load_from_load_torque = load_dist / v.dp;
   return r;
 }
@@ -266,7 +284,7 @@ ClosedLoopTransfer VelocityLoop::rational(const Polynomial& delay_num, const Pol
   const Polynomial na = act_num_ * delay_num;
   const Polynomial da = act_den_ * delay_den;
   const Polynomial open_den = dc * da * fb_den_ * plant_den_;
-  const Polynomial open_num = nc * na * fb_num_ * plant_num_;
+  const Polynomial open_num = nc * na * fb_num_ * measured_num();
   const Polynomial delta = open_den + open_num;
   ClosedLoopTransfer cl{delta,
                         TransferFunction(open_den, delta),
@@ -279,10 +297,15 @@ ClosedLoopTransfer VelocityLoop::rational(const Polynomial& delay_num, const Pol
                         std::nullopt};
   if (has_load_tracking_) cl.load_tracking = TransferFunction(nr * na * fb_den_ * load_num_, delta);
   if (has_load_) {
-    cl.motor_from_load_torque = TransferFunction(motor_dist_num_ * dc * da * fb_den_, delta);
-    cl.load_from_load_torque = TransferFunction(
-        load_dist_num_ * dc * da * fb_den_ - (1.0 / load_inertia_) * (Polynomial{1.0, 0.0} * nc * na * fb_num_), delta);
-    cl.effort_from_load_torque = TransferFunction(-1.0 * (nc * fb_num_ * motor_dist_num_ * da), delta);
+    const Polynomial closed = dc * da * fb_den_;
+    const Polynomial coupling = (1.0 / load_inertia_) * (Polynomial{1.0, 0.0} * nc * na * fb_num_);
+    // The measured velocity's disturbance numerator feeds the torque (as responses()).
+    const Polynomial& measured_dist = measures_load_ ? load_dist_num_ : motor_dist_num_;
+    cl.motor_from_load_torque =
+        TransferFunction(measures_load_ ? motor_dist_num_ * closed + coupling : motor_dist_num_ * closed, delta);
+    cl.load_from_load_torque =
+        TransferFunction(measures_load_ ? load_dist_num_ * closed : load_dist_num_ * closed - coupling, delta);
+    cl.effort_from_load_torque = TransferFunction(-1.0 * (nc * fb_num_ * measured_dist * da), delta);
   }
   return cl;
 }

@@ -44,10 +44,36 @@ double position_controller_duration(const tuning::Controller& c) {
   return kPositionTimeConstants * tau;
 }
 
-/// The measured output must be a motor-side signal: the cascade feeds back the motor.
+bool is_position_output(machine::PlantOutput o) {
+  return o == machine::PlantOutput::MotorPosition || o == machine::PlantOutput::LoadPosition;
+}
+bool is_load_output(machine::PlantOutput o) {
+  return o == machine::PlantOutput::LoadVelocity || o == machine::PlantOutput::LoadPosition;
+}
+
+/// The plant as the controller measures it: a load-measuring controller (C7.17) reads the load, so a
+/// plant that measures the motor is run with its encoder moved to the load (a note says so).
+machine::PlantConfig as_measured(const machine::PlantConfig& plant, const tuning::Controller& controller,
+                                 std::vector<std::string>& notes) {
+  if (!tuning::measures_load(controller.structure) || is_load_output(plant.settings.output)) return plant;
+  const auto* chain = std::get_if<machine::MassChain>(&plant.model);
+  if (!chain || chain->masses() < 2)
+    fail("model", "a mass chain with a load for the " + tuning::to_string(controller.structure) +
+                      " controller, which measures the load");
+  machine::PlantConfig moved = plant;
+  moved.settings.output = is_position_output(plant.settings.output) ? machine::PlantOutput::LoadPosition
+                                                                    : machine::PlantOutput::LoadVelocity;
+  notes.push_back(fmt::format("the controller measures the load: the plant's measured output moved from {} to {} (its "
+                              "noise and quantization apply there)",
+                              machine::to_string(plant.settings.output), machine::to_string(moved.settings.output)));
+  return moved;
+}
+
+/// The measured output must be on the side the controller feeds back: the motor for the cascade
+/// and the motor-feedback full-order controllers.
 void check_plant(const machine::PlantConfig& plant, const tuning::Controller& controller, DriveTest test) {
   const auto output = plant.settings.output;
-  if (output == machine::PlantOutput::LoadVelocity || output == machine::PlantOutput::LoadPosition)
+  if (is_load_output(output) && !tuning::measures_load(controller.structure))
     fail("settings.output", fmt::format("a motor-side output (motor_velocity or motor_position) for the cascade "
                                         "controller, which feeds back the motor; the plant measures {}",
                                         machine::to_string(output)));
@@ -61,7 +87,7 @@ void check_plant(const machine::PlantConfig& plant, const tuning::Controller& co
 class FeedbackReader {
  public:
   FeedbackReader(machine::PlantOutput output, double ts, double y0)
-      : position_output_(output == machine::PlantOutput::MotorPosition), ts_(ts), previous_(y0),
+      : position_output_(is_position_output(output)), ts_(ts), previous_(y0),
         position_(position_output_ ? y0 : 0.0) {}
 
   void read(double y) noexcept {
@@ -332,12 +358,13 @@ machine::PlantConfig linear_part(const machine::PlantConfig& plant) {
   return linear;
 }
 
-DriveSimulation simulate_drive(const machine::PlantConfig& plant, const tuning::Controller& controller,
+DriveSimulation simulate_drive(const machine::PlantConfig& given_plant, const tuning::Controller& controller,
                                const DriveSimulationSettings& settings) {
   check_settings(settings);
-  machine::validate(plant);
-  check_plant(plant, controller, settings.test);
+  machine::validate(given_plant);
   DriveSimulation out;
+  const machine::PlantConfig plant = as_measured(given_plant, controller, out.notes);
+  check_plant(plant, controller, settings.test);
   out.test = settings.test;
   out.structure = controller.structure;
   out.ts = plant.settings.ts;

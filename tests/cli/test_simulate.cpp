@@ -133,6 +133,23 @@ TEST_F(Cli, TuneTheFullPositionLqgAndSimulateAPositionStep) {
   EXPECT_NE(frame.err.find("closes a position loop"), std::string::npos) << frame.err;
 }
 
+TEST_F(Cli, TuneTheLoadMeasuringHinfAndSimulateIt) {
+  // C7.17: the load velocity measured. The tuner says where the search stopped, the file says
+  // "feedback": "load", and simulate moves the preset's encoder to the load and reaches ω*.
+  const Result t = run("tune table-5.1 --structure hinf-load -o hl.json");
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("velocity, load measured loop (C7.17"), std::string::npos) << t.out;
+  EXPECT_NE(slurp(path("hl.json")).find("\"feedback\": \"load\""), std::string::npos);
+  const Result r = run("simulate --controller hl.json --duration 20 -o hl.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("moved from motor_velocity to load_velocity"), std::string::npos) << r.out;
+  const auto cells = last_row(slurp(path("hl.csv")));
+  ASSERT_EQ(cells.size(), 14U);
+  EXPECT_NEAR(std::stod(cells[5]), 1.0, 0.01);  // load velocity at the reference
+  const Result compare = run("tune compare table-5.1 --structures pi,hinf-load");
+  EXPECT_NE(compare.status, 0);
+}
+
 TEST_F(Cli, SimulateLoadStepWithATorqueLimit) {
   ASSERT_EQ(run("tune table-5.1 -o pi.json").status, 0);
   const Result r = run("simulate --plant table-5.1 --controller pi.json --test load-step --amplitude 4 "

@@ -619,7 +619,7 @@ TEST_F(ControllerJsonErrors, SamplePeriodAndPrewarp) {
 }
 
 TEST_F(ControllerJsonErrors, StructureAndLoop) {
-  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"hinf\", \"lqg-pos\" or \"hinf-pos\"");
+  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"hinf-pos\" or \"hinf-load\"");
   expect(with([](auto& c) { c["position"]["kpp"] = 1.0; c["position"]["kpp_normalized"] = 1.0; }, Structure::kPiP),
          "position.kpp", "de-normalized");
   expect(with([](auto& c) { c["structure"] = "lqg"; }), "gains", "expected null for an \"lqg\" controller");
@@ -781,6 +781,26 @@ TEST(ControllerJsonRoundTrip, PositionControllersFromTheTuner) {
       for (Eigen::Index k = 0; k < 2; ++k)
         EXPECT_LE(std::abs(physical(0, k) - torque * wz * n(0, k)), 1e-9 * std::abs(physical(0, k))) << w;
     }
+  }
+}
+
+TEST(ControllerJsonRoundTrip, LoadMeasuringHinf) {
+  // hinf-load: "feedback": "load", inputs [velocity_reference, load_velocity]; a file claiming the
+  // motor is refused.
+  const Controller c = full_order_controller(Structure::kHinfLoad);
+  const nlohmann::json j = controller_to_json(c, "two_mass.json");
+  EXPECT_EQ(j["feedback"], "load");
+  EXPECT_EQ(j["loop"], "velocity");
+  EXPECT_EQ(j["state_space"]["inputs"], nlohmann::json({"velocity_reference", "load_velocity"}));
+  const LoadedController back = parse_controller_json(j.dump(), "hinf-load.json");
+  expect_round_trip(c, back.controller);
+  nlohmann::json motor = j;
+  motor["feedback"] = "motor";
+  try {
+    (void)parse_controller_json(motor.dump(), "x.json");
+    ADD_FAILURE() << "a load-measuring controller read as measuring the motor";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.where().field, "feedback");
   }
 }
 

@@ -76,21 +76,27 @@ inline core::TransferFunction frictionless_tf(double r, double zeta_z) {
           core::Polynomial{1.0, 0.0} * core::Polynomial{1.0, 2.0 * zeta_z * r * r, r * r}};
 }
 
-/// The closed loop of the position plant p (inputs [Tm, Tl], outputs [φm, φl], no feedthrough)
-/// and a position compensator k (inputs [φ*, φm], output Tm), written out here independently of
-/// the transfer-function route of VelocityLoop: inputs [φ*, Tl], outputs [φm, φl].
-inline core::StateSpace position_closed_loop_ss(const core::StateSpace& p, const core::StateSpace& k) {
+/// The closed loop of a plant p (inputs [Tm, Tl], outputs [motor, load], no feedthrough) and a
+/// compensator k (inputs [reference, measurement], output Tm) measuring output `measured` of p,
+/// written out here independently of the transfer-function route of VelocityLoop: inputs
+/// [reference, Tl], outputs p's.
+inline core::StateSpace closed_loop_ss(const core::StateSpace& p, const core::StateSpace& k, Eigen::Index measured) {
   const Eigen::Index n = p.A.rows(), m = k.A.rows();
-  const Eigen::MatrixXd bu = p.B.col(0), bt = p.B.col(1), cm = p.C.row(0);
+  const Eigen::MatrixXd bu = p.B.col(0), bt = p.B.col(1), cm = p.C.row(measured);
   core::StateSpace cl;
   cl.A.resize(n + m, n + m);
   cl.A << p.A + bu * k.D(0, 1) * cm, bu * k.C, k.B.col(1) * cm, k.A;
   cl.B.resize(n + m, 2);
   cl.B << bu * k.D(0, 0), bt, k.B.col(0), Eigen::MatrixXd::Zero(m, 1);
-  cl.C = Eigen::MatrixXd::Zero(2, n + m);
+  cl.C = Eigen::MatrixXd::Zero(p.C.rows(), n + m);
   cl.C.leftCols(n) = p.C;
-  cl.D = Eigen::MatrixXd::Zero(2, 2);
+  cl.D = Eigen::MatrixXd::Zero(p.C.rows(), 2);
   return cl;
+}
+
+/// The position plant p (outputs [φm, φl]) under a position compensator (inputs [φ*, φm]).
+inline core::StateSpace position_closed_loop_ss(const core::StateSpace& p, const core::StateSpace& k) {
+  return closed_loop_ss(p, k, 0);
 }
 
 /// f() must throw core::InputError naming `field`, with `text` in its reason.

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <numbers>
 #include <vector>
 
 #include "fixture.hpp"
@@ -19,6 +20,7 @@
 #include "servotwin/core/norms.hpp"
 #include "servotwin/core/state_space.hpp"
 #include "servotwin/tuning/compare.hpp"
+#include "servotwin/tuning/hinf.hpp"
 #include "servotwin/tuning/lqg.hpp"
 #include "servotwin/tuning/tune.hpp"
 
@@ -174,6 +176,51 @@ TEST(TunePosition, PositionStructuresAreRefusedWhereAVelocityLoopIsExpected) {
   EXPECT_EQ(to_string(Structure::kLqgPos), "lqg-pos");
   EXPECT_TRUE(is_full_order(Structure::kLqgPos) && controls_position(Structure::kHinfPos));
   EXPECT_FALSE(has_position_loop(Structure::kLqgPos));
+}
+
+TEST(TuneLoadFeedback, HinfLoadIsTheC717DesignAndItsLoopIsTheLoadMeasured) {
+  // hinf-load: C7.17's load-side H-infinity at the tuner's weights; its loop checked on the closed
+  // loop written out in state space with the LOAD velocity measured (an independent route): the
+  // load tracking at several frequencies and at the predicted bandwidth (−3 dB), integral action
+  // on ωl, and a load torque rejected from ωl at DC.
+  const fit::PlantModel model = test::two_mass_model(3.0, 0.01);
+  const TuneResult result = tune(model, position_options(Structure::kHinfLoad));
+  const Controller& c = result.controller;
+  ASSERT_TRUE(c.full_order && c.full_order->hinf);
+  VelocityHinfWeights w;
+  w.omega_0s = c.full_order->hinf->omega_0s;
+  w.omega_0t = c.full_order->hinf->omega_0t;
+  const core::StateSpace k = load_side_hinf(result.plant, w).compensator;
+  for (const double x : {0.05, 0.5, 2.0})
+    for (Eigen::Index i = 0; i < 2; ++i)
+      EXPECT_LT(std::abs(core::frequency_response(c.full_order->compensator, x, 0, i) - core::frequency_response(k, x, 0, i)),
+                1e-6 * std::abs(core::frequency_response(k, x, 0, i)));
+  const FrictionTwoMass m = *two_mass_realization(result.plant);
+  const core::StateSpace cl = test::closed_loop_ss(two_mass_state_space(m, false), c.full_order->compensator, 1);
+  const VelocityLoop loop = controller_loop(result.plant, c);
+  ASSERT_TRUE(loop.measures_load());
+  for (const double x : {0.01, 0.3, 1.0, 3.0, 10.0}) {
+    const Complex direct = core::frequency_response(cl, x, 1, 0);
+    EXPECT_LT(std::abs(loop.load_tracking(x) - direct), 1e-8 * std::abs(direct)) << x;
+    EXPECT_LT(std::abs(loop.load_from_load_torque(x) - core::frequency_response(cl, x, 1, 1)),
+              1e-8 * std::abs(core::frequency_response(cl, x, 1, 1)) + 1e-12) << x;
+  }
+  EXPECT_NEAR(std::abs(core::frequency_response(cl, c.predicted.bandwidth_load, 1, 0)), std::pow(10.0, -3.0 / 20.0), 1e-6);
+  EXPECT_NEAR(std::abs(core::frequency_response(cl, 1e-7, 1, 0)), 1.0, 1e-6);
+  EXPECT_LT(std::abs(core::frequency_response(cl, 1e-10, 1, 1)), 1e-6);
+  EXPECT_LE(c.predicted.peak_s, 1.5 * (1.0 + 1e-3));
+  EXPECT_LE(c.predicted.peak_tl, 1.5 * (1.0 + 1e-3));
+  // The scan is not cut short on load feedback: a band of infeasible w0S (0.08 to 0.18 here)
+  // separates the slow designs from the fast ones, and the chosen design is a fast one.
+  EXPECT_GT(c.full_order->hinf->omega_0s, 0.5);
+  EXPECT_GT(c.predicted.bandwidth_load, 2.0);
+  // A plant with a higher mode has no two-mass load to measure.
+  fit::PlantModel two_modes = model;
+  two_modes.modes.push_back({{8.0 * 2.0 * std::numbers::pi * 40.0, 0.01}, {10.0 * 2.0 * std::numbers::pi * 40.0, 0.02}});
+  test::expect_input_error([&] { (void)tune(two_modes, position_options(Structure::kHinfLoad)); }, "--structure",
+                           "needs a two-mass plant");
+  test::expect_input_error(
+      [&] { (void)compare_structures(model, TuneOptions{}, {Structure::kHinfLoad}); }, "structures", "measures the load");
 }
 
 }  // namespace tune_position_test

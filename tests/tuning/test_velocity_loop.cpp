@@ -146,6 +146,49 @@ TEST(VelocityLoop, RationalClosedLoopAgreesWithTheExactFunctions) {
   }
 }
 
+TEST(VelocityLoop, LoadFeedbackIsTheBlockDiagramWithTheLoadMeasured) {
+  // C7.17: the controller reads ωl. Composition with the delay exact: L = C F A Plm, S = 1/(1 + L),
+  // ωm/ω* = R A Pm S, ωl/ω* = R A Plm S, u/ω* = R S, ωl/Tl = Gll S (the measured output's
+  // disturbance), ωm/Tl = Gml − Pm A C F Gll S; the rational closed loop (Padé delay) agrees below
+  // the bandwidth, and the load loop's integral action holds ωl at ω* (DC 1) and rejects Tl from ωl.
+  NormalizedPlant plant = plant_with_hf();
+  const PidGains g{0.6, 0.2, 0.0, 0.0, 1.0, 0.0};
+  const ControllerTf k = pid_controller(g);
+  const VelocityLoop loop = VelocityLoop::load_feedback(plant, k);
+  const TwoMassTransfer t = *two_mass_transfer(plant);
+  ASSERT_TRUE(loop.measures_load() && loop.has_load());
+  for (double w : kOmegas) {
+    const Complex s(0.0, w);
+    const Complex a = plant.hf.actuator_response(w), f = plant.hf.feedback_response(w);
+    const Complex c = k.feedback(s), r = k.reference(s), pm = t.motor_from_torque(s), pl = t.load_from_torque(s);
+    const Complex l = c * f * a * pl, sens = 1.0 / (1.0 + l);
+    EXPECT_LT(rel(loop.loop_gain(w), l), 1e-11) << w;
+    EXPECT_LT(rel(loop.sensitivity(w), sens), 1e-11) << w;
+    EXPECT_LT(std::abs(loop.sensitivity(w) + loop.complementary(w) - 1.0), 1e-11) << w;
+    EXPECT_LT(rel(loop.motor_tracking(w), r * a * pm * sens), 1e-11) << w;
+    EXPECT_LT(rel(loop.load_tracking(w), r * a * pl * sens), 1e-11) << w;
+    EXPECT_LT(rel(loop.effort(w), r * sens), 1e-11) << w;
+    EXPECT_LT(rel(loop.load_from_load_torque(w), t.load_from_load_torque(s) * sens), 1e-10) << w;
+    const Complex motor = t.motor_from_load_torque(s) - pm * a * c * f * t.load_from_load_torque(s) * sens;
+    EXPECT_LT(rel(loop.motor_from_load_torque(w), motor), 1e-9) << w;
+  }
+  ASSERT_TRUE(loop.stable());
+  const ClosedLoopTransfer cl = loop.closed_loop();
+  for (double w : {1e-3, 0.05, 0.3, 1.0}) {
+    EXPECT_LT(rel(cl.sensitivity.frequency_response(w), loop.sensitivity(w)), 1e-6) << w;
+    EXPECT_LT(rel(cl.load_tracking->frequency_response(w), loop.load_tracking(w)), 1e-6) << w;
+    EXPECT_LT(rel(cl.motor_from_load_torque->frequency_response(w), loop.motor_from_load_torque(w)), 1e-6) << w;
+    EXPECT_LT(rel(cl.load_from_load_torque->frequency_response(w), loop.load_from_load_torque(w)), 1e-6) << w;
+    const Complex u_tl = -loop.controller(w) * plant.hf.feedback_response(w) * loop.load_from_load_torque(w);
+    EXPECT_LT(rel(cl.effort_from_load_torque->frequency_response(w), u_tl), 1e-6) << w;
+  }
+  EXPECT_LT(std::abs(loop.load_tracking(0.0) - 1.0), 1e-12);
+  EXPECT_LT(std::abs(loop.load_from_load_torque(0.0)), 1e-12);
+  NormalizedPlant modes = plant;
+  modes.higher_modes.push_back({{9.0, 0.01}, {12.0, 0.02}});
+  EXPECT_THROW((void)VelocityLoop::load_feedback(modes, k), std::invalid_argument);
+}
+
 TEST(VelocityLoop, E26ClosedLoopPoles) {
   // E26 (ω* = 0.30 corrected, catalog misprint 3): poles −0.3 (double) and −2.10747 ± 1.63480j.
   const NormalizedPlant plant = normalized_two_mass(3.0, 0.01);

@@ -202,6 +202,30 @@ TEST(DriveSimulation, PositionControllersFollowTheirContinuousLoopsInPhysicalUni
   }
 }
 
+TEST(DriveSimulation, LoadMeasuringControllerFollowsItsContinuousLoop) {
+  // hinf-load (C7.17) reads the load velocity: the plant's encoder is moved to the load (with a
+  // note), and the sampled loop follows the continuous load-feedback loop (VelocityLoop::
+  // load_feedback, time scaled by omega_z) in physical units; a load torque is rejected from ωl
+  // and balanced by the motor torque at rest (closed form).
+  const auto plant = scaled_plant();
+  const auto r = tuned(plant, tuning::Structure::kHinfLoad);
+  DriveSimulationSettings s;
+  s.duration_s = 20.0;
+  const DriveSimulation sim = simulate_drive(plant, r.controller, s);
+  ASSERT_FALSE(sim.notes.empty());
+  EXPECT_NE(sim.notes.front().find("moved from motor_velocity to load_velocity"), std::string::npos) << sim.notes.front();
+  const auto loop = tuning::controller_loop(r.plant, r.controller, false).closed_loop();
+  const double dt_normalized = plant.settings.ts * r.controller.plant.omega_z;
+  const auto load = core::step_response(*loop.load_tracking, dt_normalized, sim.samples.size());
+  EXPECT_LT(max_difference(sim.samples, load, [](const DriveSample& x) { return x.load_velocity; }), 5e-3);
+  EXPECT_NEAR(sim.samples.back().load_velocity, 1.0, 1e-4);
+  s.test = DriveTest::kLoadStep;
+  s.amplitude = 3.0;
+  const DriveSimulation disturbance = simulate_drive(plant, r.controller, s);
+  EXPECT_NEAR(disturbance.samples.back().load_velocity, 0.0, 1e-4);
+  EXPECT_NEAR(disturbance.samples.back().torque_command, 3.0, 1e-3);
+}
+
 TEST(DriveSimulation, IntegralActionRemovesCoulombFrictionAtConstantVelocity) {
   auto plant = normalized_plant();
   auto& chain = std::get<machine::MassChain>(plant.model);

@@ -17,6 +17,8 @@
 ///             prefilter 1/(τ s + 1) (one more state)
 ///   hinf-pos  the H-infinity mixed-sensitivity position controller of C7.14 (K0/s on the position
 ///             error; inputs [φ*, φm]) with the same kind of prefilter
+///   hinf-load the H-infinity velocity controller of C7.17 measuring the LOAD velocity (inputs
+///             [ω*, ωl]; a load encoder)
 
 #include <optional>
 #include <string>
@@ -32,7 +34,7 @@
 namespace servotwin::tuning {
 
 /// Controller structure offered by the tuner.
-enum class Structure { kPi, kPid, kPiP, kLqg, kLqgP, kHinf, kLqgPos, kHinfPos };
+enum class Structure { kPi, kPid, kPiP, kLqg, kLqgP, kHinf, kLqgPos, kHinfPos, kHinfLoad };
 
 /// A structure whose controller is a general state space (no PID gains): lqg, lqg+p, hinf,
 /// lqg-pos, hinf-pos.
@@ -48,10 +50,13 @@ enum class Structure { kPi, kPid, kPiP, kLqg, kLqgP, kHinf, kLqgPos, kHinfPos };
 /// is_position_controller.
 [[nodiscard]] bool controls_position(Structure structure) noexcept;
 
-/// An H-infinity structure: hinf, hinf-pos.
+/// An H-infinity structure: hinf, hinf-pos, hinf-load.
 [[nodiscard]] bool is_hinf(Structure structure) noexcept;
 
-/// "pi", "pid", "pi+p", "lqg", "lqg+p", "hinf", "lqg-pos", "hinf-pos".
+/// The controller measures the load velocity (C7.17): hinf-load.
+[[nodiscard]] bool measures_load(Structure structure) noexcept;
+
+/// "pi", "pid", "pi+p", "lqg", "lqg+p", "hinf", "lqg-pos", "hinf-pos", "hinf-load".
 [[nodiscard]] std::string to_string(Structure structure);
 /// Inverse of to_string; std::nullopt for an unknown name.
 [[nodiscard]] std::optional<Structure> structure_from_string(const std::string& name);
@@ -166,6 +171,12 @@ struct Controller {
 /// PID's, or the full-order compensator's two_dof_form() (a position controller's in its
 /// velocity_form(): the loop's S, T and margins are then the position loop's).
 [[nodiscard]] ControllerTf normalized_controller(const Controller& controller);
+
+/// The loop of `controller` on `plant` (normalized): normalized_controller() around the motor, or
+/// around the load for a load-measuring structure (VelocityLoop::load_feedback). `with_hf` and
+/// `with_higher_modes` as in VelocityLoop (a load-measuring loop always has the first mode only).
+[[nodiscard]] VelocityLoop controller_loop(const NormalizedPlant& plant, const Controller& controller,
+                                          bool with_hf = true, bool with_higher_modes = true);
 
 /// Tustin discretization of controller_state_space at the drive period ts [s] (physical gains),
 /// prewarped at `prewarp_rad_s` when given (it must lie below π/ts). Throws core::InputError

@@ -138,6 +138,9 @@ struct LoopIndices {
 /// The same for any 2-DoF controller (an LQG's two_dof_form()).
 [[nodiscard]] LoopIndices analyse(const NormalizedPlant& plant, const ControllerTf& controller,
                                   const AnalysisOptions& options = {});
+/// analyse() of a loop on `plant`, with the plant's frequencies (1 = ωz, r, the higher modes) added
+/// to the grid and the HF gain taken at 10 r unless given (as the PidGains/ControllerTf overloads).
+[[nodiscard]] LoopIndices analyse(const NormalizedPlant& plant, const VelocityLoop& loop, const AnalysisOptions& options);
 
 /// J1/J2 search settings (C7.8).
 struct IndexOptions {

@@ -89,9 +89,21 @@ class VelocityLoop {
   VelocityLoop(const NormalizedPlant& plant, ControllerTf controller, bool with_hf = true,
                bool with_higher_modes = true, int pade_order = 6);
 
+  /// The loop around `controller` measuring the LOAD velocity (C7.17 load-side feedback): the
+  /// feedback path sees Pl = ωl/Tm of the two-mass realization (with its HF dynamics), so L, S, T
+  /// and the margins are those of the load loop; the tracking and load-torque functions keep their
+  /// meaning (ωm/ω*, ωl/ω*, ωm/Tl = Gmd − Pm·CAF·Gld·S, ωl/Tl = Gld·S). std::invalid_argument for a
+  /// plant without a two-mass realization (higher modes, or negative shaft damping).
+  [[nodiscard]] static VelocityLoop load_feedback(const NormalizedPlant& plant, ControllerTf controller,
+                                                  bool with_hf = true, int pade_order = 6);
+  /// The loop measures the load velocity (load_feedback), not the motor's.
+  [[nodiscard]] bool measures_load() const noexcept { return measures_load_; }
+
   [[nodiscard]] const ControllerTf& controller_tf() const noexcept { return controller_; }
   /// Pm = plant_num/plant_den (without the HF dynamics; higher modes as constructed).
   [[nodiscard]] const core::Polynomial& plant_num() const noexcept { return plant_num_; }
+  /// The measured plant's numerator over plant_den: plant_num (motor) or Pl's (load_feedback).
+  [[nodiscard]] const core::Polynomial& measured_num() const noexcept { return measures_load_ ? load_num_ : plant_num_; }
   [[nodiscard]] const core::Polynomial& plant_den() const noexcept { return plant_den_; }
   /// |C(j∞)|: the controller's high-frequency gain (the ratio of leading coefficients).
   [[nodiscard]] double controller_hf_limit() const noexcept;
@@ -153,6 +165,7 @@ class VelocityLoop {
   // Two-mass numerators over plant_den: ωl/Tm (with higher modes in the chain: of load_estimate()), ωm/Tl, ωl/Tl; load_inertia Il (normalized).
   core::Polynomial load_num_, motor_dist_num_, load_dist_num_;
   double load_inertia_ = 1.0;
+  bool measures_load_ = false;
   int pade_order_ = 6;
   double r_ = 0.0;
   core::Polynomial characteristic_;  // Δ with the Padé delay

@@ -16,8 +16,10 @@
 /// Feedback signals: a motor_velocity plant output is the velocity feedback (the position of a
 /// pi+p loop or of a position controller is its trapezoidal integral); a motor_position output (an
 /// encoder) is the position feedback and its backward difference the velocity, so encoder
-/// quantization reaches the loop as a drive sees it. Load-side outputs are refused: the cascade
-/// feeds back the motor. A full-order position controller (lqg-pos, hinf-pos) reads [φ*, φm].
+/// quantization reaches the loop as a drive sees it. Load-side outputs are refused for controllers
+/// that feed back the motor; a load-measuring controller (hinf-load, C7.17) reads the load's output
+/// (a plant that measures the motor is run with its encoder moved to the load, and a note says so).
+/// A full-order position controller (lqg-pos, hinf-pos) reads [φ*, φm].
 ///
 /// Signs: the load torque Tl opposes the motion (Il ω̇l = T_shaft − Tl − friction), the
 /// dissertation's convention and tuning::VelocityLoop's.
