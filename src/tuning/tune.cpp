@@ -514,7 +514,6 @@ std::optional<double> automatic_kbw(const LqgDesigner& lqg, const SpecCheck& che
   return chosen.omega_star;
 }
 
-/// Automatic kbw, the measurement noise raised where needed (search_raising_noise).
 /// Runs the kbw search `found()` (true when some kbw met the spec); when none does, raises the
 /// Kalman filter's measurement noise `v` by decades (at most kMaxNoiseDecades, when allowed) and
 /// searches again: C7.13's estimator has a fixed bandwidth (its weights do not scale with kbw), too
@@ -535,6 +534,7 @@ void search_raising_noise(double& v, const TuneOptions& options, TuneResult& res
   }
 }
 
+/// Automatic kbw, the measurement noise raised where needed (search_raising_noise).
 void choose_kbw(const NormalizedPlant& plant, const LqgModel& model, const TuneOptions& options,
                 const SpecCheck& check, FullOrderSummary& f, TuneResult& result) {
   search_raising_noise(f.weights.measurement_noise, options, result, [&] {
