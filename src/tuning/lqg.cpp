@@ -311,6 +311,18 @@ ControllerTf two_dof_form(const core::StateSpace& c) {
   return {core::TransferFunction(-1.0 * measurement.num(), den), core::TransferFunction(reference.num(), den)};
 }
 
+TwoMeasurementController two_measurement_form(const core::StateSpace& c) {
+  if (c.inputs() != 3 || c.outputs() != 1)
+    throw std::invalid_argument("two_measurement_form: expected a compensator with inputs [reference, wm, wl] and one output");
+  const core::TransferFunction reference = core::to_transfer_function(c, 0, 0);
+  const core::TransferFunction motor = core::to_transfer_function(c, 0, 1);
+  const core::TransferFunction load = core::to_transfer_function(c, 0, 2);
+  // All over det(sI − Ac); one copy of it for the loop algebra (as two_dof_form).
+  const core::Polynomial& den = motor.den();
+  return {{core::TransferFunction(-1.0 * motor.num(), den), core::TransferFunction(reference.num(), den)},
+          core::TransferFunction(-1.0 * load.num(), den)};
+}
+
 ControllerTf velocity_form(const ControllerTf& position) {
   const core::Polynomial s{1.0, 0.0};
   const core::Polynomial den = position.feedback.den() * s;

@@ -97,7 +97,8 @@ TransferFunction pade_delay(double delay, int order) {
 
 struct VelocityLoop::Values {
   Complex nc, dc, nr, na, da, nf, df, np, dp, delta;
-  Complex nm;  // the measured plant's numerator: np, or Pl's
+  Complex cm, cl;  // the feedback numerators on ωm and ωl (0 for a channel not measured)
+  Complex nm;      // Σ channel·plant numerator (cm·np + cl·nl): L = na nf nm/(dc da df dp)
 };
 
 VelocityLoop::VelocityLoop(const NormalizedPlant& plant, const PidGains& gains, bool with_hf, bool with_higher_modes,
@@ -152,10 +153,42 @@ VelocityLoop VelocityLoop::load_feedback(const NormalizedPlant& plant, Controlle
   VelocityLoop loop(plant, std::move(controller), with_hf, true, pade_order);
   if (!loop.has_load_)
     throw std::invalid_argument("VelocityLoop::load_feedback: the plant has no two-mass realization to measure the load of");
-  loop.measures_load_ = true;
+  loop.measured_ = Measured::kLoad;
   const TransferFunction pade = pade_delay(loop.delay_, loop.pade_order_);
   loop.characteristic_ = loop.characteristic(pade.num(), pade.den());
   return loop;
+}
+
+VelocityLoop VelocityLoop::two_measurements(const NormalizedPlant& plant, TwoMeasurementController controller,
+                                            bool with_hf, int pade_order) {
+  if (!(controller.load.den() == controller.motor.feedback.den()))
+    throw std::invalid_argument("VelocityLoop::two_measurements: the load channel must share the controller's denominator");
+  if (controller.load.num().degree() > controller.load.den().degree())
+    throw std::invalid_argument("VelocityLoop::two_measurements: the load channel must be proper");
+  VelocityLoop loop = load_feedback(plant, std::move(controller.motor), with_hf, pade_order);
+  loop.measured_ = Measured::kBoth;
+  loop.load_channel_ = controller.load.num();
+  const TransferFunction pade = pade_delay(loop.delay_, loop.pade_order_);
+  loop.characteristic_ = loop.characteristic(pade.num(), pade.den());
+  return loop;
+}
+
+Polynomial VelocityLoop::motor_channel_num() const {
+  return measured_ == Measured::kLoad ? Polynomial{} : controller_.feedback.num();
+}
+
+Polynomial VelocityLoop::load_channel_num() const {
+  switch (measured_) {
+    case Measured::kLoad: return controller_.feedback.num();
+    case Measured::kBoth: return load_channel_;
+    case Measured::kMotor: break;
+  }
+  return {};
+}
+
+Polynomial VelocityLoop::measured_combination() const {
+  if (measured_ == Measured::kMotor) return controller_.feedback.num() * plant_num_;
+  return motor_channel_num() * plant_num_ + load_channel_num() * load_num_;
 }
 
 double VelocityLoop::controller_hf_limit() const noexcept {
@@ -168,7 +201,7 @@ double VelocityLoop::controller_hf_limit() const noexcept {
 Polynomial VelocityLoop::characteristic(const Polynomial& delay_num, const Polynomial& delay_den) const {
   // The same products, in the same order, as rational(): both give the identical Δ.
   return controller_.feedback.den() * (act_den_ * delay_den) * fb_den_ * plant_den_ +
-         controller_.feedback.num() * (act_num_ * delay_num) * fb_num_ * measured_num();
+         (act_num_ * delay_num) * fb_num_ * measured_combination();
 }
 
 VelocityLoop::Values VelocityLoop::values(double omega) const noexcept {
@@ -183,8 +216,12 @@ VelocityLoop::Values VelocityLoop::values(double omega) const noexcept {
   v.df = fb_den_(s);
   v.np = plant_num_(s);
   v.dp = plant_den_(s);
-  v.nm = measures_load_ ? load_num_(s) : v.np;
-  v.delta = v.dc * v.da * v.df * v.dp + v.nc * v.na * v.nf * v.nm;
+  v.cm = measured_ == Measured::kLoad ? Complex(0.0, 0.0) : v.nc;
+  v.cl = measured_ == Measured::kMotor ? Complex(0.0, 0.0)
+         : measured_ == Measured::kLoad ? v.nc
+                                         : load_channel_(s);
+  v.nm = v.cm * v.np + (measured_ == Measured::kMotor ? Complex(0.0, 0.0) : v.cl * load_num_(s));
+  v.delta = v.dc * v.da * v.df * v.dp + v.na * v.nf * v.nm;
   return v;
 }
 
@@ -199,7 +236,7 @@ Complex VelocityLoop::plant(double omega) const noexcept {
 
 Complex VelocityLoop::loop_gain(double omega) const noexcept {
   const Values v = values(omega);
-  return (v.nc * v.na * v.nf * v.nm) / (v.dc * v.da * v.df * v.dp);
+  return (v.na * v.nf * v.nm) / (v.dc * v.da * v.df * v.dp);
 }
 
 Complex VelocityLoop::sensitivity(double omega) const noexcept {
@@ -209,7 +246,7 @@ Complex VelocityLoop::sensitivity(double omega) const noexcept {
 
 Complex VelocityLoop::complementary(double omega) const noexcept {
   const Values v = values(omega);
-  return v.nc * v.na * v.nf * v.nm / v.delta;
+  return v.na * v.nf * v.nm / v.delta;
 }
 
 Complex VelocityLoop::motor_tracking(double omega) const noexcept {
@@ -247,7 +284,7 @@ Complex VelocityLoop::open_loop_load_from_load_torque(double omega) const noexce
 VelocityLoop::Responses VelocityLoop::responses(double omega) const noexcept {
   const Values v = values(omega);
   const Complex s(0.0, omega);
-  const Complex open = v.nc * v.na * v.nf * v.nm;
+  const Complex open = v.na * v.nf * v.nm;
   const Complex plant_side = v.dc * v.da * v.df * v.dp;
   Responses r;
   r.loop_gain = open / plant_side;
@@ -264,27 +301,23 @@ VelocityLoop::Responses VelocityLoop::responses(double omega) const noexcept {
   // The measured velocity's disturbance is the open one times S; the other's is the open one minus
   // the torque's effect. With the two-mass identity nLl·nP − nLm·nMl = −s·dP/Il the dP cancels
   // exactly, which keeps the value finite at ω = 0 for an integrating plant.
+  // ωm/Tl = (md·dc da df + s na nf cl/Il)/Δ, ωl/Tl = (ld·dc da df − s na nf cm/Il)/Δ: each channel's
+  // torque reaches the other velocity through the shaft only (md·nl − np·ld = s·dp/Il).
   const Complex closed = v.dc * v.da * v.df;
-  const Complex coupling = s * v.nc * v.na * v.nf / load_inertia_;
-  if (measures_load_) {
-    r.motor_from_load_torque = (motor_dist_num_(s) * closed + coupling) / v.delta;
-    r.load_from_load_torque = load_dist * closed / v.delta;
-  } else {
-    r.motor_from_load_torque = motor_dist_num_(s) * closed / v.delta;
-    r.load_from_load_torque = (load_dist * closed - coupling) / v.delta;
-  }
+  const Complex shaft = s * v.na * v.nf / load_inertia_;
+  r.motor_from_load_torque = (motor_dist_num_(s) * closed + shaft * v.cl) / v.delta;
+  r.load_from_load_torque = (load_dist * closed - shaft * v.cm) / v.delta;
   r.open_loop_load_from_load_torque = load_dist / v.dp;
   return r;
 }
 
 ClosedLoopTransfer VelocityLoop::rational(const Polynomial& delay_num, const Polynomial& delay_den) const {
-  const Polynomial& nc = controller_.feedback.num();
   const Polynomial& dc = controller_.feedback.den();
   const Polynomial& nr = controller_.reference.num();
   const Polynomial na = act_num_ * delay_num;
   const Polynomial da = act_den_ * delay_den;
   const Polynomial open_den = dc * da * fb_den_ * plant_den_;
-  const Polynomial open_num = nc * na * fb_num_ * measured_num();
+  const Polynomial open_num = na * fb_num_ * measured_combination();
   const Polynomial delta = open_den + open_num;
   ClosedLoopTransfer cl{delta,
                         TransferFunction(open_den, delta),
@@ -297,15 +330,14 @@ ClosedLoopTransfer VelocityLoop::rational(const Polynomial& delay_num, const Pol
                         std::nullopt};
   if (has_load_tracking_) cl.load_tracking = TransferFunction(nr * na * fb_den_ * load_num_, delta);
   if (has_load_) {
+    // As responses(); u/Tl = −nf da (cm·md + cl·ld)/Δ.
     const Polynomial closed = dc * da * fb_den_;
-    const Polynomial coupling = (1.0 / load_inertia_) * (Polynomial{1.0, 0.0} * nc * na * fb_num_);
-    // The measured velocity's disturbance numerator feeds the torque (as responses()).
-    const Polynomial& measured_dist = measures_load_ ? load_dist_num_ : motor_dist_num_;
-    cl.motor_from_load_torque =
-        TransferFunction(measures_load_ ? motor_dist_num_ * closed + coupling : motor_dist_num_ * closed, delta);
-    cl.load_from_load_torque =
-        TransferFunction(measures_load_ ? load_dist_num_ * closed : load_dist_num_ * closed - coupling, delta);
-    cl.effort_from_load_torque = TransferFunction(-1.0 * (nc * fb_num_ * measured_dist * da), delta);
+    const Polynomial shaft = (1.0 / load_inertia_) * (Polynomial{1.0, 0.0} * na * fb_num_);
+    const Polynomial cm = motor_channel_num(), cl_load = load_channel_num();
+    cl.motor_from_load_torque = TransferFunction(motor_dist_num_ * closed + shaft * cl_load, delta);
+    cl.load_from_load_torque = TransferFunction(load_dist_num_ * closed + (-1.0) * (shaft * cm), delta);
+    cl.effort_from_load_torque =
+        TransferFunction(-1.0 * (fb_num_ * (cm * motor_dist_num_ + cl_load * load_dist_num_) * da), delta);
   }
   return cl;
 }

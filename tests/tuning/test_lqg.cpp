@@ -275,6 +275,53 @@ TEST(Lqg, LoadSideFeedbackIsMoreRobustAtTheSameWeights) {
   }
 }
 
+TEST(Lqg, LoadSideLoopWithBothMeasurementsHasScipysPolesAndTheStateSpaceResponses) {
+  // C7.17's LQG measures both velocities: the loop of VelocityLoop::two_measurements around its
+  // two_measurement_form must have exactly scipy's regulator and estimator poles (separation), and
+  // its tracking and load-torque functions must equal the closed loop of plant and compensator
+  // written out in state space with both velocities fed back.
+  const auto& c = lqg_reference().at("load_side").at(0);
+  ASSERT_EQ(c.at("bm").get<double>(), 0.0);
+  const double r = c.at("r");
+  VelocityLqgOptions o;
+  o.kbw = c.at("kbw");
+  const NormalizedPlant plant = normalized_two_mass(r, c.at("zeta_z"));
+  const FrictionTwoMass m = *two_mass_realization(plant);
+  const LqgDesign d = load_side_lqg(m, r, o);
+  const VelocityLoop loop = VelocityLoop::two_measurements(plant, two_measurement_form(d.compensator), false);
+  ASSERT_TRUE(loop.measures_both() && loop.stable());
+  std::vector<std::complex<double>> expected = roots_of(c.at("lqr_poles"));
+  for (const auto& p : roots_of(c.at("kf_poles"))) expected.push_back(p);
+  expect_same_roots(loop.characteristic_polynomial().roots(), expected, 1e-6, "loop");
+  // The state-space loop: u = Cc xc + D [w*, wm, wl], plant outputs [wm, wl], inputs [Tm, Tl].
+  const core::StateSpace p = two_mass_state_space(m, false);
+  const core::StateSpace& k = d.compensator;
+  const Eigen::Index n = p.A.rows(), q = k.A.rows();
+  core::StateSpace cl;
+  cl.A.resize(n + q, n + q);
+  cl.A << p.A + p.B.col(0) * k.D.rightCols(2) * p.C, p.B.col(0) * k.C, k.B.rightCols(2) * p.C, k.A;
+  cl.B.resize(n + q, 2);
+  cl.B << p.B.col(0) * k.D(0, 0), p.B.col(1), k.B.col(0), Eigen::MatrixXd::Zero(q, 1);
+  cl.C = Eigen::MatrixXd::Zero(2, n + q);
+  cl.C.leftCols(n) = p.C;
+  cl.D = Eigen::MatrixXd::Zero(2, 2);
+  for (const double w : {0.01, 0.3, 1.0, 2.9, 10.0}) {
+    const auto close = [&](std::complex<double> got, Eigen::Index out, Eigen::Index in, const char* what) {
+      const std::complex<double> want = core::frequency_response(cl, w, out, in);
+      EXPECT_LT(std::abs(got - want), 1e-8 * std::max(std::abs(want), 1e-3)) << what << " at " << w;
+    };
+    close(loop.motor_tracking(w), 0, 0, "wm/w*");
+    close(loop.load_tracking(w), 1, 0, "wl/w*");
+    close(loop.motor_from_load_torque(w), 0, 1, "wm/Tl");
+    close(loop.load_from_load_torque(w), 1, 1, "wl/Tl");
+  }
+  const ClosedLoopTransfer rational = loop.closed_loop();
+  for (const double w : {0.01, 1.0, 10.0})
+    EXPECT_LT(std::abs(rational.load_from_load_torque->frequency_response(w) - loop.load_from_load_torque(w)),
+              1e-8 * std::max(std::abs(loop.load_from_load_torque(w)), 1e-3));
+  EXPECT_THROW((void)two_measurement_form(velocity_lqg(m, r, o).compensator), std::invalid_argument);
+}
+
 TEST(Lqg, TwoDofFormRealizesTheCompensator) {
   // C1 = u/ω* and C2 = −u/y of the state space, evaluated directly (core::frequency_response).
   for (const bool raw : {false, true}) {

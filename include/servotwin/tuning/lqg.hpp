@@ -118,6 +118,11 @@ struct LqgDesign {
 /// unless the compensator has 2 inputs and 1 output.
 [[nodiscard]] ControllerTf two_dof_form(const core::StateSpace& compensator);
 
+/// The same for a compensator with inputs [reference, ωm, ωl] (load_side_lqg): R, Cm = −(u/ωm) and
+/// Cl = −(u/ωl) over det(sI − Ac), for VelocityLoop::two_measurements. std::invalid_argument unless
+/// it has 3 inputs and 1 output.
+[[nodiscard]] TwoMeasurementController two_measurement_form(const core::StateSpace& compensator);
+
 /// A position controller u = C1 φ* − C2 φm in the velocity form a VelocityLoop takes (reference
 /// input still φ*, measurement ωm = s φm): feedback C2/s and reference C1, both over den·s. On a
 /// VelocityLoop built from it, S, T and the margins are the position loop's, and ωm/φ*, ωl/φ*,

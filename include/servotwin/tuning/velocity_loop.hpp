@@ -36,6 +36,13 @@ struct ControllerTf {
   core::TransferFunction reference;  ///< R(s) (same denominator as C)
 };
 
+/// A controller measuring both velocities (C7.17's load-side LQG, inputs [ω*, ωm, ωl]):
+/// u = R ω* − Cm ωm − Cl ωl over one denominator.
+struct TwoMeasurementController {
+  ControllerTf motor;           ///< R (reference) and Cm (feedback, on ωm)
+  core::TransferFunction load;  ///< Cl on ωl (the denominator of motor.feedback)
+};
+
 /// C(s) and R(s) of the gains above. τ = 0 with kd ≠ 0 is an improper (ideal) derivative and is
 /// refused (std::invalid_argument); kd = 0 gives the PI s-denominator only.
 [[nodiscard]] ControllerTf pid_controller(const PidGains& gains);
@@ -96,14 +103,25 @@ class VelocityLoop {
   /// plant without a two-mass realization (higher modes, or negative shaft damping).
   [[nodiscard]] static VelocityLoop load_feedback(const NormalizedPlant& plant, ControllerTf controller,
                                                   bool with_hf = true, int pade_order = 6);
-  /// The loop measures the load velocity (load_feedback), not the motor's.
-  [[nodiscard]] bool measures_load() const noexcept { return measures_load_; }
+  /// The loop around a controller measuring both velocities: L = (Cm Pm + Cl Pl)·A·F (broken at
+  /// the plant input), ωm/Tl = (Gml·(1 + A F Cl Pl) − Pm A F Cl Gll)·S, ωl/Tl the same with the
+  /// roles swapped (both from the two-mass identity; see the .cpp). The measurement filter and
+  /// delay act on both channels. std::invalid_argument as load_feedback, or when the load channel
+  /// does not share the controller's denominator.
+  [[nodiscard]] static VelocityLoop two_measurements(const NormalizedPlant& plant, TwoMeasurementController controller,
+                                                     bool with_hf = true, int pade_order = 6);
+  /// The loop measures the load velocity (load_feedback or two_measurements).
+  [[nodiscard]] bool measures_load() const noexcept { return measured_ != Measured::kMotor; }
+  /// The loop measures the motor velocity too (two_measurements).
+  [[nodiscard]] bool measures_both() const noexcept { return measured_ == Measured::kBoth; }
 
   [[nodiscard]] const ControllerTf& controller_tf() const noexcept { return controller_; }
   /// Pm = plant_num/plant_den (without the HF dynamics; higher modes as constructed).
   [[nodiscard]] const core::Polynomial& plant_num() const noexcept { return plant_num_; }
   /// The measured plant's numerator over plant_den: plant_num (motor) or Pl's (load_feedback).
-  [[nodiscard]] const core::Polynomial& measured_num() const noexcept { return measures_load_ ? load_num_ : plant_num_; }
+  [[nodiscard]] const core::Polynomial& measured_num() const noexcept {
+    return measured_ == Measured::kLoad ? load_num_ : plant_num_;
+  }
   [[nodiscard]] const core::Polynomial& plant_den() const noexcept { return plant_den_; }
   /// |C(j∞)|: the controller's high-frequency gain (the ratio of leading coefficients).
   [[nodiscard]] double controller_hf_limit() const noexcept;
@@ -165,7 +183,16 @@ class VelocityLoop {
   // Two-mass numerators over plant_den: ωl/Tm (with higher modes in the chain: of load_estimate()), ωm/Tl, ωl/Tl; load_inertia Il (normalized).
   core::Polynomial load_num_, motor_dist_num_, load_dist_num_;
   double load_inertia_ = 1.0;
-  bool measures_load_ = false;
+  /// What the feedback reads: the motor (controller_.feedback on ωm), the load (on ωl), or both
+  /// (controller_.feedback on ωm, load_channel_ on ωl).
+  enum class Measured { kMotor, kLoad, kBoth };
+  Measured measured_ = Measured::kMotor;
+  core::Polynomial load_channel_;  // Cl's numerator over controller_.feedback.den() (kBoth)
+  /// The feedback numerators on ωm and on ωl (a zero polynomial for a channel not measured).
+  [[nodiscard]] core::Polynomial motor_channel_num() const;
+  [[nodiscard]] core::Polynomial load_channel_num() const;
+  /// Σ channel·plant numerator: the loop's open numerator without A and F (ncm·np + ncl·nl).
+  [[nodiscard]] core::Polynomial measured_combination() const;
   int pade_order_ = 6;
   double r_ = 0.0;
   core::Polynomial characteristic_;  // Δ with the Padé delay
