@@ -106,13 +106,25 @@ core::StateSpace controller_state_space(const Controller& c) {
 ControllerTf normalized_controller(const Controller& c) {
   if (!is_full_order(c.structure)) return pid_controller(c.normalized);
   if (!c.full_order) throw std::invalid_argument("normalized_controller: a full-order controller without its compensator");
-  const ControllerTf tf = two_dof_form(c.full_order->compensator);
-  return is_position_controller(c.structure) ? velocity_form(tf) : tf;
+  return compensator_form(c.structure, c.full_order->compensator);
+}
+
+ControllerTf compensator_form(Structure structure, const core::StateSpace& compensator) {
+  const ControllerTf tf = two_dof_form(compensator);
+  return is_position_controller(structure) ? velocity_form(tf) : tf;
+}
+
+VelocityLoop compensator_loop(const NormalizedPlant& plant, Structure structure, const core::StateSpace& compensator,
+                              bool with_hf, bool with_higher_modes) {
+  const ControllerTf tf = compensator_form(structure, compensator);
+  if (measures_load(structure)) return VelocityLoop::load_feedback(plant.first_mode(), tf, with_hf);
+  return VelocityLoop(plant, tf, with_hf, with_higher_modes);
 }
 
 VelocityLoop controller_loop(const NormalizedPlant& plant, const Controller& c, bool with_hf, bool with_higher_modes) {
-  if (measures_load(c.structure)) return VelocityLoop::load_feedback(plant.first_mode(), normalized_controller(c), with_hf);
-  return VelocityLoop(plant, normalized_controller(c), with_hf, with_higher_modes);
+  if (!is_full_order(c.structure)) return VelocityLoop(plant, pid_controller(c.normalized), with_hf, with_higher_modes);
+  if (!c.full_order) throw std::invalid_argument("controller_loop: a full-order controller without its compensator");
+  return compensator_loop(plant, c.structure, c.full_order->compensator, with_hf, with_higher_modes);
 }
 
 namespace {

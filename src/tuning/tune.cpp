@@ -434,7 +434,7 @@ struct LqgDesigner {
     w.feedforward = kff;
     return velocity_lqg(model.two_mass, model.modes, plant.r, w);
   }
-  [[nodiscard]] VelocityLoop loop(const LqgDesign& d) const { return VelocityLoop(plant, two_dof_form(d.compensator)); }
+  [[nodiscard]] VelocityLoop loop(const LqgDesign& d) const { return compensator_loop(plant, Structure::kLqg, d.compensator); }
 };
 
 /// The LQG's design model: the first mode's two-mass realization with friction, extended by the
@@ -563,13 +563,9 @@ std::string pole_list(const std::vector<std::complex<double>>& poles) {
 VelocityLoop finish_full_order(TuneResult& result, const TuneOptions& options, const SpecCheck& check,
                                FullOrderSummary f, const std::string& knob, const std::string& kind) {
   Controller& c = result.controller;
-  const bool position = is_position_controller(options.structure);
-  const ControllerTf tf = position ? velocity_form(two_dof_form(f.compensator)) : two_dof_form(f.compensator);
   AnalysisOptions analysis;
-  analysis.position_outputs = position;
-  const VelocityLoop loop = measures_load(options.structure)
-                                ? VelocityLoop::load_feedback(result.plant, tf)
-                                : VelocityLoop(result.plant, tf);
+  analysis.position_outputs = is_position_controller(options.structure);
+  const VelocityLoop loop = compensator_loop(result.plant, options.structure, f.compensator);
   c.predicted = analyse(result.plant, loop, analysis);
   if (!c.predicted.closed_loop_stable) c.notes.push_back("the loop with the known HF dynamics is UNSTABLE at this " + knob);
   if (!f.controller_stable) {
@@ -620,7 +616,7 @@ void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& c
 /// position (the load's, else the motor's) free of overshoot on the loop with the HF dynamics,
 /// put in front of the compensator's reference input (its pole joins the controller's).
 void add_prefilter(const NormalizedPlant& plant, const SpecCheck& check, FullOrderSummary& f) {
-  const VelocityLoop loop(plant, velocity_form(two_dof_form(f.compensator)));
+  const VelocityLoop loop = compensator_loop(plant, check.options.structure, f.compensator);
   if (!loop.stable()) return;  // finish_full_order says so; no prefilter can help
   constexpr double kFinalPrefilterTolerance = 1e-9;
   const std::optional<double> tau = check.prefilter(check.judged_tracking(loop), kFinalPrefilterTolerance);
@@ -646,7 +642,7 @@ struct PositionLqgDesigner {
     return position_lqg(model, plant.r, w);
   }
   [[nodiscard]] VelocityLoop loop(const LqgDesign& d) const {
-    return VelocityLoop(plant, velocity_form(two_dof_form(d.compensator)));
+    return compensator_loop(plant, Structure::kLqgPos, d.compensator);
   }
 };
 
@@ -722,9 +718,7 @@ struct HinfDesigner {
     return is_position_controller(options.structure) ? position_hinf(design_plant, w) : velocity_hinf(design_plant, w);
   }
   [[nodiscard]] VelocityLoop loop(const HinfDesign& d) const {
-    const ControllerTf tf = two_dof_form(d.compensator);
-    if (measures_load(options.structure)) return VelocityLoop::load_feedback(plant, tf);
-    return VelocityLoop(plant, is_position_controller(options.structure) ? velocity_form(tf) : tf);
+    return compensator_loop(plant, options.structure, d.compensator);
   }
 };
 

@@ -172,9 +172,19 @@ struct Controller {
 /// velocity_form(): the loop's S, T and margins are then the position loop's).
 [[nodiscard]] ControllerTf normalized_controller(const Controller& controller);
 
-/// The loop of `controller` on `plant` (normalized): normalized_controller() around the motor, or
-/// around the load for a load-measuring structure (VelocityLoop::load_feedback). `with_hf` and
-/// `with_higher_modes` as in VelocityLoop (a load-measuring loop always has the first mode only).
+/// A full-order `structure`'s normalized compensator as the transfer functions a VelocityLoop
+/// takes: its two_dof_form(), in velocity_form() for a position controller.
+[[nodiscard]] ControllerTf compensator_form(Structure structure, const core::StateSpace& compensator);
+
+/// The loop of a full-order `structure`'s normalized compensator on `plant`: compensator_form()
+/// around the motor, or around the load for a load-measuring structure (VelocityLoop::load_feedback
+/// on the first mode). `with_hf` and `with_higher_modes` as in VelocityLoop.
+[[nodiscard]] VelocityLoop compensator_loop(const NormalizedPlant& plant, Structure structure,
+                                           const core::StateSpace& compensator, bool with_hf = true,
+                                           bool with_higher_modes = true);
+
+/// The loop of `controller` on `plant` (normalized): the PID's, or compensator_loop(). `with_hf`
+/// and `with_higher_modes` as in VelocityLoop (a load-measuring loop always has the first mode only).
 [[nodiscard]] VelocityLoop controller_loop(const NormalizedPlant& plant, const Controller& controller,
                                           bool with_hf = true, bool with_higher_modes = true);
 
