@@ -495,12 +495,17 @@ ReadError error_of(const std::string& text) {
 
 class ControllerJsonErrors : public ::testing::Test {
  protected:
+  /// The error after editing a copy of `document`.
+  template <typename Edit>
+  static ReadError edited_copy(const nlohmann::json& document, Edit edit) {
+    nlohmann::json copy = document;
+    edit(copy);
+    return error_of(copy.dump());
+  }
   /// The error after editing a PID (with discrete part) or PI+P document.
   template <typename Edit>
   ReadError with(Edit edit, Structure s = Structure::kPid) const {
-    nlohmann::json copy = controller_to_json(make_controller(s, true, false), "p.json");
-    edit(copy);
-    return error_of(copy.dump());
+    return edited_copy(controller_to_json(make_controller(s, true, false), "p.json"), edit);
   }
   static void expect(const ReadError& e, const std::string& field, const std::string& fragment) {
     EXPECT_EQ(e.field, field) << e.message;
@@ -660,11 +665,7 @@ TEST(ControllerJsonRoundTrip, LqgPlusPCarriesItsPositionGainInThePositionSection
 
 TEST_F(ControllerJsonErrors, LqgDocuments) {
   static const nlohmann::json lqg = controller_to_json(lqg_controller(), "p.json");
-  const auto edited = [](auto edit) {
-    nlohmann::json copy = lqg;
-    edit(copy);
-    return error_of(copy.dump());
-  };
+  const auto edited = [](auto edit) { return edited_copy(lqg, edit); };
   EXPECT_EQ(edited([](auto&) {}).message, "no error");
   expect(edited([](auto& c) { c["lqg"]["controller_poles"][0][0] = 99.0; }), "lqg.controller_poles[0]",
          "not an eigenvalue");
@@ -720,11 +721,7 @@ TEST(ControllerJsonRoundTrip, HinfWithARollOff) {
 
 TEST_F(ControllerJsonErrors, HinfDocuments) {
   static const nlohmann::json hinf = controller_to_json(full_order_controller(Structure::kHinf), "p.json");
-  const auto edited = [](auto edit) {
-    nlohmann::json copy = hinf;
-    edit(copy);
-    return error_of(copy.dump());
-  };
+  const auto edited = [](auto edit) { return edited_copy(hinf, edit); };
   EXPECT_EQ(edited([](auto&) {}).message, "no error");
   expect(edited([](auto& c) { c["hinf"] = nullptr; }), "hinf", "needs its compensator");
   expect(edited([](auto& c) { c["hinf"]["gamma"] = 0.5 * c["hinf"]["gamma_optimal"].template get<double>(); }),
@@ -796,21 +793,12 @@ TEST(ControllerJsonRoundTrip, LoadMeasuringHinf) {
   expect_round_trip(c, back.controller);
   nlohmann::json motor = j;
   motor["feedback"] = "motor";
-  try {
-    (void)parse_controller_json(motor.dump(), "x.json");
-    ADD_FAILURE() << "a load-measuring controller read as measuring the motor";
-  } catch (const core::InputError& e) {
-    EXPECT_EQ(e.where().field, "feedback");
-  }
+  EXPECT_EQ(error_of(motor.dump()).field, "feedback");
 }
 
 TEST_F(ControllerJsonErrors, PositionControllerDocuments) {
   static const nlohmann::json lqg = controller_to_json(full_order_controller(Structure::kLqgPos), "p.json");
-  const auto edited = [](auto edit) {
-    nlohmann::json copy = lqg;
-    edit(copy);
-    return error_of(copy.dump());
-  };
+  const auto edited = [](auto edit) { return edited_copy(lqg, edit); };
   EXPECT_EQ(edited([](auto&) {}).message, "no error");
   expect(edited([](auto& c) { c["lqg"]["compensator"]["inputs"] = {"velocity_reference", "motor_velocity"}; }),
          "lqg.compensator.inputs", "[\"position_reference\",\"motor_position\"]");
