@@ -34,8 +34,8 @@ int run(const ModelArgs& a, const GlobalOptions& global) {
              c.a1, c.a2, c.a3, c.b0, c.b1, c.b2, c.d0, c.d1);
   print_roots("poles", m.poles());
   print_roots("zeros", m.zeros());
-  fmt::print("  {}; tracking bandwidth {:.2f} Hz; tracking DC gain {:.6g}\n", m.is_stable() ? "stable" : "UNSTABLE",
-             m.bandwidth_hz(), m.tracking().dc_gain());
+  fmt::print("  {}; {}; tracking DC gain {:.6g}\n", m.is_stable() ? "stable" : "UNSTABLE", bandwidth_text(m),
+             m.tracking().dc_gain());
   if (a.frf.empty()) return kSuccess;
 
   const double nyquist_hz = 0.5 / m.ts();

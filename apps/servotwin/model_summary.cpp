@@ -25,6 +25,15 @@ void print_refinement(const vcnc::AxisIdentification& r) {
              r.solver_fit ? r.solver_fit->nrmse : std::nan(""), r.fit ? r.fit->nrmse : std::nan(""), f.iterations,
              f.simulations, f.time_ms, f.stop_reason);
 }
+/// Tells the user when the reading's encoder count alone keeps the score from zero, so a
+/// quantized short-stroke error is not taken for a bad model (the thesis's 1.25 um ball screw).
+void print_quantization_floor(const rapid::FitMetrics& f, const std::string& unit) {
+  if (f.quantization_floor < 0.01) return;  // below 1 % it does not change what a score means
+  fmt::print("  the reading's count {:.4g} {} alone gives nrmse {:.4f} (q/sqrt(12) of the error's spread): no "
+             "prediction from the command scores below it\n",
+             f.reading_quantum, unit, f.quantization_floor);
+}
+
 }  // namespace
 
 std::string roots_text(const std::vector<core::ModalInfo>& roots) {
@@ -36,6 +45,12 @@ std::string roots_text(const std::vector<core::ModalInfo>& roots) {
 
 void print_roots(const char* label, const std::vector<core::ModalInfo>& roots) {
   fmt::print("  {}: {}\n", label, roots_text(roots));
+}
+
+std::string bandwidth_text(const rapid::AxisModel& model) {
+  const double f = model.bandwidth_hz();
+  if (std::isinf(f)) return fmt::format("tracking bandwidth above the Nyquist frequency ({:.4g} Hz)", 0.5 / model.ts());
+  return fmt::format("tracking bandwidth {:.2f} Hz", f);
 }
 
 void print_model_summary(const vcnc::AxisIdentification& r) {
@@ -61,7 +76,7 @@ void print_model_summary(const vcnc::AxisIdentification& r) {
   }
   print_roots("poles", model.poles());
   print_roots("zeros", model.zeros());
-  fmt::print("  {}; tracking bandwidth {:.2f} Hz\n", model.is_stable() ? "stable" : "UNSTABLE", model.bandwidth_hz());
+  fmt::print("  {}; {}\n", model.is_stable() ? "stable" : "UNSTABLE", bandwidth_text(model));
   if (!r.shift_trials.empty()) {
     fmt::print("  command shift {} samples, chosen by fit from:", r.regressors.command_shift);
     for (const auto& t : r.shift_trials) fmt::print(" {}:{:.4f}{}", t.shift, t.nrmse, t.stable ? "" : "(unstable)");
@@ -77,6 +92,7 @@ void print_model_summary(const vcnc::AxisIdentification& r) {
                r.validation->rms_measured, r.length_unit, r.validation->nrmse,
                r.solver_validation ? fmt::format(" (solver's model before refinement: {:.4f})", r.solver_validation->nrmse)
                                    : std::string());
+  print_quantization_floor(r.validation ? *r.validation : r.fit ? *r.fit : rapid::FitMetrics{}, r.length_unit);
   for (const auto& w : s.warnings) fmt::print("  warning: {}\n", w);
 }
 

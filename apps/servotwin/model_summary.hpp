@@ -16,6 +16,10 @@ void print_roots(const char* label, const std::vector<core::ModalInfo>& roots);
 /// "none" when there are none.
 std::string roots_text(const std::vector<core::ModalInfo>& roots);
 
+/// "tracking bandwidth 21.63 Hz", or "... above the Nyquist frequency (500 Hz)" when the gain
+/// never falls 3 dB below it there (a ZPETC-like loop), rather than "inf".
+std::string bandwidth_text(const rapid::AxisModel& model);
+
 void print_model_summary(const vcnc::AxisIdentification& identification);
 
 }  // namespace servotwin::cli

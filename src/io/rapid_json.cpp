@@ -29,8 +29,13 @@ json modal_list(const std::vector<core::ModalInfo>& roots) {
 }
 
 json fit_to_json(const rapid::FitMetrics& f) {
-  return {{"rms", f.rms_difference},          {"nrmse", number_or_null(f.nrmse)}, {"max", f.max_difference},
-          {"rms_measured", f.rms_measured}, {"rms_predicted", f.rms_predicted}};
+  json j = {{"rms", f.rms_difference},          {"nrmse", number_or_null(f.nrmse)}, {"max", f.max_difference},
+            {"rms_measured", f.rms_measured}, {"rms_predicted", f.rms_predicted}};
+  if (f.reading_quantum > 0.0) {
+    j["reading_quantum"] = f.reading_quantum;
+    j["quantization_floor"] = f.quantization_floor;
+  }
+  return j;
 }
 
 double read_element(const json& v, const std::string& field, std::string_view source) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "servotwin/core/error.hpp"
 #include "servotwin/rapid/axis_model.hpp"
@@ -81,7 +82,34 @@ FitMetrics compare_tracking(std::span<const double> measured_error, std::span<co
     m.nrmse = difference.value() / deviation.value();
   }
   m.fit_percent = 100.0 * (1.0 - m.nrmse);
+  m.std_measured = deviation.value() / root_n;
   return m;
+}
+
+double reading_quantum(std::span<const double> positions) {
+  std::vector<double> values;
+  values.reserve(positions.size());
+  for (const double x : positions)
+    if (std::isfinite(x)) values.push_back(x);
+  std::sort(values.begin(), values.end());
+  values.erase(std::unique(values.begin(), values.end()), values.end());
+  if (values.size() < 3) return 0.0;
+  double count = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 1; k < values.size(); ++k) count = std::min(count, values[k] - values[k - 1]);
+  // A gap of a few ulps of the largest reading is round-off, not a count.
+  const double largest = std::max(std::abs(values.front()), std::abs(values.back()));
+  if (count <= 1e-12 * largest) return 0.0;
+  for (std::size_t k = 1; k < values.size(); ++k) {
+    const double steps = (values[k] - values[k - 1]) / count;
+    if (std::abs(steps - std::round(steps)) > 0.01) return 0.0;
+  }
+  return count;
+}
+
+void set_reading_quantum(FitMetrics& fit, double quantum) {
+  fit.reading_quantum = quantum > 0.0 && std::isfinite(quantum) ? quantum : 0.0;
+  fit.quantization_floor =
+      fit.reading_quantum > 0.0 && fit.std_measured > 0.0 ? fit.reading_quantum / std::sqrt(12.0) / fit.std_measured : 0.0;
 }
 
 FitMetrics simulation_fit(const AxisModel& model, std::span<const double> command, std::span<const double> actual,

@@ -100,6 +100,17 @@ rapid::FitMetrics simulated_fit(const rapid::AxisModel& model, const std::vector
 
 namespace {
 
+/// The encoder count the captures' actual positions share, 0 when any has none or they differ.
+double captures_quantum(const std::vector<NamedCapture>& captures, const std::string& axis) {
+  double common = 0.0;
+  for (const auto& c : captures) {
+    const double q = rapid::reading_quantum(require_axis(c, axis).act);
+    if (q == 0.0 || (common != 0.0 && std::abs(q - common) > 1e-9 * common)) return 0.0;
+    common = q;
+  }
+  return common;
+}
+
 /// Identification with the shift in settings.regressors.
 AxisIdentification identify_with_shift(const std::vector<NamedCapture>& captures, const std::string& axis,
                                        const IdentificationSettings& settings, const rapid::Bounds& bounds) {
@@ -210,6 +221,15 @@ AxisIdentification identify_axis(const std::vector<NamedCapture>& captures, cons
       result.solver_validation = simulated_fit(rapid::AxisModel(result.solution.coefficients, result.ts), validation, axis,
                                                result.regressors.command_shift);
     }
+  }
+  // Once, at the end: the quantum sorts every reading, and the shift search does not need it.
+  const double fit_quantum = captures_quantum(captures, axis);
+  for (auto* fit : {&result.fit, &result.solver_fit})
+    if (*fit) rapid::set_reading_quantum(**fit, fit_quantum);
+  if (!validation.empty()) {
+    const double validation_quantum = captures_quantum(validation, axis);
+    for (auto* fit : {&result.validation, &result.solver_validation})
+      if (*fit) rapid::set_reading_quantum(**fit, validation_quantum);
   }
   for (const auto& c : captures) result.sources.push_back(c.source);
   return result;

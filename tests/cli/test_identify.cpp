@@ -13,6 +13,7 @@ namespace {
 using servotwin::cli_test::Cli;
 using servotwin::cli_test::slurp;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using json = nlohmann::json;
 
 class Identify : public Cli {
@@ -47,6 +48,29 @@ TEST_F(Identify, RefineWritesTheRefinedModelWithTheSolversBeside) {
   EXPECT_TRUE(m["stable"].get<bool>());
   // predict simulates the refined model: its coefficients are "model".
   ASSERT_EQ(run("model model.json").status, 0);
+}
+
+TEST_F(Identify, SaysWhenTheEncoderCountLimitsTheScore) {
+  // The ZPETC preset's 3.5 um tracking error is read by a 1.25 um encoder (thesis section 3.4.2):
+  // the count alone is about 10 % of the error's spread, which the summary and the file say.
+  capture("zpetc", "ballscrew-zpetc", 7);
+  capture("zpetc_check", "ballscrew-zpetc", 11);
+  auto r = run("identify zpetc.csv --axis x --validate zpetc_check.csv -o model.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("the reading's count 0.00125 as in the file alone gives nrmse 0.10"));
+  const json m = read_json("model.json");
+  EXPECT_NEAR(m["validation"]["reading_quantum"].get<double>(), 1.25e-3, 1e-9);
+  EXPECT_NEAR(m["validation"]["quantization_floor"].get<double>(), 0.103, 0.005);
+  EXPECT_NEAR(m["fit"]["reading_quantum"].get<double>(), 1.25e-3, 1e-9);
+  // The PID preset's 42 um error is far above its 1 um count: the file has the count, the
+  // summary no line (its floor is under 1 %).
+  capture("pid");
+  r = run("identify pid.csv --axis x -o pid.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, Not(HasSubstr("the reading's count")));
+  const json pid = read_json("pid.json");
+  EXPECT_NEAR(pid["fit"]["reading_quantum"].get<double>(), 1e-3, 1e-9);
+  EXPECT_LT(pid["fit"]["quantization_floor"].get<double>(), 0.01);
 }
 
 TEST_F(Identify, IssueCommandFormsProduceTheDocumentedFiles) {

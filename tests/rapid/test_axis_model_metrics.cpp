@@ -113,6 +113,63 @@ TEST(AxisModelMetrics, SimulationFitOnIdentificationAndValidationCaptures) {
   }
 }
 
+/// A slow sine sampled at 1 kHz: positions that pass every count of a grid many times.
+std::vector<double> sine_positions(double amplitude, double offset) {
+  std::vector<double> x(5000);
+  for (std::size_t k = 0; k < x.size(); ++k) x[k] = offset + amplitude * std::sin(2.0 * M_PI * 0.7 * kTs * static_cast<double>(k));
+  return x;
+}
+
+std::vector<double> quantized(std::vector<double> x, double q, double offset) {
+  for (double& v : x) v = offset + q * std::round((v - offset) / q);
+  return x;
+}
+
+TEST(ReadingQuantum, FindsTheEncoderCountOfAQuantizedReading) {
+  // The thesis's ball screw: 1.25 um of table motion per count (section 3.4.2), in mm, on a grid
+  // that does not pass through 0.
+  const std::vector<double> reading = quantized(sine_positions(5.0, 12.3), 1.25e-3, 0.0004);
+  EXPECT_NEAR(reading_quantum(reading), 1.25e-3, 1e-12);
+  // The same reading in um: the count scales with the unit.
+  std::vector<double> in_um = reading;
+  for (double& v : in_um) v *= 1000.0;
+  EXPECT_NEAR(reading_quantum(in_um), 1.25, 1e-9);
+}
+
+TEST(ReadingQuantum, NoCountInAContinuousOrTooPoorReading) {
+  EXPECT_EQ(reading_quantum(sine_positions(5.0, 12.3)), 0.0);                         // floating point, no grid
+  EXPECT_EQ(reading_quantum(std::vector<double>{1.0, 1.0, 1.0}), 0.0);                  // one value
+  EXPECT_EQ(reading_quantum(std::vector<double>{0.0, 0.5}), 0.0);                       // two values: no evidence
+  EXPECT_EQ(reading_quantum(std::vector<double>{0.0, 1.0, 2.5}), 0.0);                  // 1.5 is not a multiple of 1
+  EXPECT_EQ(reading_quantum(std::vector<double>{}), 0.0);
+  // Non-finite samples are not positions: the rest still shows its grid.
+  EXPECT_NEAR(reading_quantum(std::vector<double>{0.0, std::nan(""), 0.25, 0.75, 1.0}), 0.25, 1e-15);
+}
+
+TEST(ReadingQuantum, FloorIsWhatAPerfectPredictionScoresAgainstTheQuantizedReading) {
+  // Measured error: command - quantized position; a perfect prediction knows the true position.
+  // Its nrmse is the quantization error's RMS over the error's spread, which the uniform model
+  // q / sqrt(12) predicts (to a few per cent on a reading that crosses many counts).
+  const double q = 1e-3;
+  const std::vector<double> command = sine_positions(2.0, 0.0);
+  std::vector<double> position(command.size());
+  for (std::size_t k = 0; k < command.size(); ++k)
+    position[k] = command[k] - 0.004 * std::cos(2.0 * M_PI * 0.7 * kTs * static_cast<double>(k));  // 4 um lag
+  const std::vector<double> reading = quantized(position, q, 0.0);
+  std::vector<double> measured(command.size()), perfect(command.size());
+  for (std::size_t k = 0; k < command.size(); ++k) {
+    measured[k] = command[k] - reading[k];
+    perfect[k] = command[k] - position[k];
+  }
+  FitMetrics m = compare_tracking(measured, perfect);
+  set_reading_quantum(m, reading_quantum(reading));
+  EXPECT_NEAR(m.reading_quantum, q, 1e-12);
+  EXPECT_NEAR(m.quantization_floor, q / std::sqrt(12.0) / m.std_measured, 1e-12);
+  EXPECT_NEAR(m.nrmse / m.quantization_floor, 1.0, 0.05);
+  set_reading_quantum(m, 0.0);
+  EXPECT_EQ(m.quantization_floor, 0.0);
+}
+
 }  // namespace axis_model_metrics_test
 }  // namespace
 }  // namespace servotwin::rapid

@@ -118,11 +118,14 @@ INSTANTIATE_TEST_SUITE_P(Presets, PresetIdentification,
                          });
 
 /// With the output-error refinement (rapid/refine.hpp) on the identification data. The bound is
-/// the 10 %. The ZPETC loop's 3.5 um RMS error is of the order of its 1.25 um encoder
-/// quantum: against the encoder's reading the residual cannot fall below the quantization noise
-/// (q / sqrt(12) = 10.4 %), and against the true table position the loop's own reaction to the
-/// quantized feedback (which no model driven by the command can predict) remains: 14 % and
-/// 9.7-10.2 % are measured, bounded at 16 % and 11 %.
+/// the 10 %, or, where even a perfect prediction cannot reach it, the best any prediction
+/// driven by the command can do: the machine itself run again without its encoder quantum
+/// (quantum_free_machine_ratio). The ZPETC loop's 3.5 um RMS error is of the order of its 1.25 um
+/// encoder quantum (the thesis's ball-screw drive, section 3.4.2): that machine scores 13.9 % and
+/// 14.2 % against the reading, and 9.3 % / 9.6 % against its own true table position, because
+/// the loop reacts to its quantized feedback in a way no command-driven model can follow. The
+/// refined model scores 14.1 / 14.6 % and 9.7 / 10.2 %. The size of the error (its RMS level) is
+/// predicted within 10 % on every preset.
 struct RefinedCase {
   const char* machine;
   double to_reading;  // prediction error vs the encoder's reading, both other programs
@@ -164,6 +167,17 @@ TEST_P(RefinedIdentification, PredictsTrackingOfOtherProgramsWithinTenPercent) {
   EXPECT_LT(o.prediction_high_set, GetParam().to_reading);
   EXPECT_LT(truth_other, GetParam().to_truth);
   EXPECT_LT(truth_high, GetParam().to_truth);
+  // The 10 %, or within 5 % of the floor no command-driven prediction can beat.
+  const double floor_other = quantum_free_machine_ratio(machine, other);
+  const double floor_high = quantum_free_machine_ratio(machine, high);
+  const double level_other = rms_level_error(model, other, shift);
+  const double level_high = rms_level_error(model, high, shift);
+  std::printf("  the machine without its encoder quantum vs reading: %.4f, %.4f; RMS level error %.4f, %.4f\n",
+              floor_other, floor_high, level_other, level_high);
+  EXPECT_LT(o.prediction_same_kind, std::max(0.10, 1.05 * floor_other));
+  EXPECT_LT(o.prediction_high_set, std::max(0.10, 1.05 * floor_high));
+  EXPECT_LT(level_other, 0.10);
+  EXPECT_LT(level_high, 0.10);
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, RefinedIdentification,

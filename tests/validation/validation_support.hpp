@@ -57,21 +57,63 @@ inline double tracking_frf_error(const rapid::AxisModel& model, const machine::A
   return worst;
 }
 
+/// The model's tracking error on the capture's command, started at the capture's first reading.
+inline std::vector<double> model_tracking_error(const rapid::AxisModel& model, const core::AxisTrace& trace, int shift) {
+  rapid::ModelSimulationOptions options;
+  options.command_shift = shift;
+  options.initial_position = trace.act.front();
+  return model.simulate(trace.cmd, options).tracking_error;
+}
+
 /// RMS of (predicted - actual tracking error) / RMS of the actual one, the actual error being
 /// command - `position`, the model simulated from the command and the capture's first reading.
 inline double error_ratio(const rapid::AxisModel& model, const core::AxisTrace& trace, const std::vector<double>& position,
                           int shift) {
-  rapid::ModelSimulationOptions options;
-  options.command_shift = shift;
-  options.initial_position = trace.act.front();
-  const rapid::ModelResponse r = model.simulate(trace.cmd, options);
+  const std::vector<double> predicted = model_tracking_error(model, trace, shift);
   double diff = 0.0, actual = 0.0;
   for (std::size_t k = 0; k < trace.cmd.size(); ++k) {
     const double e = trace.cmd[k] - position[k];
-    diff += (r.tracking_error[k] - e) * (r.tracking_error[k] - e);
+    diff += (predicted[k] - e) * (predicted[k] - e);
     actual += e * e;
   }
   return std::sqrt(diff / actual);
+}
+
+/// RMS of (predicted - actual tracking error) / RMS of the actual one, for positions already
+/// predicted by any means (the tracking errors are command - position).
+inline double position_error_ratio(const std::vector<double>& command, const std::vector<double>& predicted,
+                                   const std::vector<double>& actual) {
+  double diff = 0.0, norm = 0.0;
+  for (std::size_t k = 0; k < command.size(); ++k) {
+    diff += (predicted[k] - actual[k]) * (predicted[k] - actual[k]);
+    norm += (command[k] - actual[k]) * (command[k] - actual[k]);
+  }
+  return std::sqrt(diff / norm);
+}
+
+/// |RMS(predicted tracking error) / RMS(actual tracking error) - 1|: how well the size of the
+/// error is predicted, the level a user reads off a twin before machining.
+inline double rms_level_error(const rapid::AxisModel& model, const core::AxisTrace& trace, int shift) {
+  const std::vector<double> error = model_tracking_error(model, trace, shift);
+  double predicted = 0.0, actual = 0.0;
+  for (std::size_t k = 0; k < trace.cmd.size(); ++k) {
+    predicted += error[k] * error[k];
+    actual += (trace.cmd[k] - trace.act[k]) * (trace.cmd[k] - trace.act[k]);
+  }
+  return std::abs(std::sqrt(predicted / actual) - 1.0);
+}
+
+/// The best any prediction driven by the command can score against the encoder's reading: the
+/// machine itself (same friction, same noise stream) run again without its encoder quantum, whose
+/// table position is then compared with the quantized reading like a model's prediction.
+inline double quantum_free_machine_ratio(const machine::MachineConfig& machine, const core::AxisTrace& trace) {
+  machine::AxisConfig ideal = machine.axes.front();
+  ideal.nonlinear.encoder_resolution = 0.0;
+  machine::SimulationOptions o;
+  o.record_states = true;
+  o.record_u = false;
+  const machine::AxisRun run = machine::simulate_axis(ideal, machine.ts, trace.cmd, o, 0);
+  return position_error_ratio(trace.cmd, run.table, trace.act);
 }
 
 /// RMS of (predicted - actual tracking error) / RMS of the actual tracking error on a capture.

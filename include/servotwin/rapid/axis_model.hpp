@@ -176,8 +176,25 @@ struct FitMetrics {
   /// sample for sample and +inf otherwise.
   double nrmse = 0.0;
   double fit_percent = 0.0;     ///< 100 (1 - nrmse)
+  double std_measured = 0.0;    ///< standard deviation of the measured tracking error (nrmse's scale)
+  /// Step of the grid the actual positions lie on (an encoder's count), 0 when none was found
+  /// or looked for (set_reading_quantum).
+  double reading_quantum = 0.0;
+  /// The nrmse the reading's quantization alone gives a perfect prediction: (q / sqrt(12)) /
+  /// std_measured. No prediction driven by the command scores below it; 0 without a quantum.
+  double quantization_floor = 0.0;
   std::size_t samples = 0;
 };
+
+/// The count of the grid `positions` lie on: the smallest gap between distinct values, accepted
+/// only when every gap between adjacent distinct values is a whole multiple of it (to 1 % of
+/// the count) and it is not floating-point round-off. 0 when there is no such grid (positions
+/// that vary continuously, fewer than three distinct values, or readings printed with too few
+/// significant digits to keep one count). Sorts a copy: O(n log n), call it once per capture.
+double reading_quantum(std::span<const double> positions);
+
+/// Sets fit.reading_quantum and the quantization_floor that follows from it (q = 0 clears both).
+void set_reading_quantum(FitMetrics& fit, double quantum);
 /// core::InputError (fields "measured_error", "predicted_error[k]") for different lengths, empty
 /// input or a non-finite sample (e.g. the prediction of an unstable model).
 FitMetrics compare_tracking(std::span<const double> measured_error, std::span<const double> predicted_error);
