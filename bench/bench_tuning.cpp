@@ -165,6 +165,21 @@ void BM_TuneAutomatic(benchmark::State& state) {
 }
 BENCHMARK(BM_TuneAutomatic)->DenseRange(0, 8)->Unit(benchmark::kMillisecond);
 
+/// The load-measuring designs of C7.17 on the belt axis's first mode alone (they need a two-mass
+/// load): Arg 0 hinf-load (the w0S scan over its whole range: feasibility is not monotone on load
+/// feedback), 1 lqg-load (kbw and feedforward searches on the two-measurement loop).
+void BM_TuneLoadSide(benchmark::State& state) {
+  fit::PlantModel model = belt_axis();
+  model.modes.resize(1);
+  TuneOptions o;
+  o.ms = 2.0;
+  o.mt = 2.0;
+  o.structure = state.range(0) == 0 ? Structure::kHinfLoad : Structure::kLqgLoad;
+  for (auto _ : state) benchmark::DoNotOptimize(tune(model, o));
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_TuneLoadSide)->DenseRange(0, 1)->Unit(benchmark::kMillisecond);
+
 /// One C7.14 velocity design (generalized plant, gamma iteration to 1e-4 with the closed loop
 /// checked near the optimum, K0/s): the inner step of the w0S search; a few milliseconds.
 void BM_VelocityHinfDesign(benchmark::State& state) {

@@ -125,9 +125,11 @@ void print_lqg(tuning::Structure structure, const tuning::FullOrderSummary& f, c
     fmt::print("compensator: {}\n", f.controller_stable ? "stable" : "UNSTABLE (stable only inside the closed loop)");
     return;
   }
-  fmt::print("structure {}: LQG velocity loop (C7.13, {} states): kbw = {:.4g} ({}), feedforward kff = {:.4g} "
+  fmt::print("structure {}: LQG velocity loop ({}, {} states): kbw = {:.4g} ({}), feedforward kff = {:.4g} "
              "normalized = {:.4g} torque per velocity ({})\n",
-             tuning::to_string(structure), f.compensator.states(), f.weights.kbw, f.kbw_source, f.weights.feedforward,
+             tuning::to_string(structure),
+             tuning::measures_both(structure) ? "C7.17, integral on the load, motor and load velocity measured" : "C7.13",
+             f.compensator.states(), f.weights.kbw, f.kbw_source, f.weights.feedforward,
              f.weights.feedforward * scales.motor_inertia * scales.omega_z, f.feedforward_source);
   fmt::print("compensator: {}\n", f.controller_stable ? "stable" : "UNSTABLE (stable only inside the closed loop)");
 }
@@ -301,9 +303,11 @@ void register_tune(CLI::App& app, Action& selected) {
                   "pi, pid (virtual inertia, C7.5), pi+p (P position loop over the PI), lqg (full-order velocity "
                   "LQG, C7.13), lqg+p (P position loop over the LQG), hinf (H-infinity mixed-sensitivity velocity "
                   "loop, C7.14), lqg-pos (full-order position LQG with its reference prefilter, C7.13), hinf-pos "
-                  "(H-infinity position loop with a reference prefilter, C7.14) or hinf-load (H-infinity velocity "
-                  "loop measuring the load velocity: a load encoder, C7.17)")
-      ->check(CLI::IsMember({"pi", "pid", "pi+p", "lqg", "lqg+p", "hinf", "lqg-pos", "hinf-pos", "hinf-load"}))
+                  "(H-infinity position loop with a reference prefilter, C7.14), hinf-load (H-infinity velocity "
+                  "loop measuring the load velocity: a load encoder, C7.17) or lqg-load (LQG velocity loop with "
+                  "integral action on the load, measuring motor and load velocity, C7.17)")
+      ->check(CLI::IsMember({"pi", "pid", "pi+p", "lqg", "lqg+p", "hinf", "lqg-pos", "hinf-pos", "hinf-load",
+                             "lqg-load"}))
       ->capture_default_str();
   cmd->add_option("--zeta-star", a->zeta_star, "Damping of the assigned closed-loop pole pair")->capture_default_str();
   cmd->add_option("--omega-star", a->omega_star,
@@ -365,6 +369,7 @@ void register_tune(CLI::App& app, Action& selected) {
                "  servotwin tune table-5.1 --structure hinf --ts 0.000125 -o hinf.json\n"
                "  servotwin tune table-5.1 --structure lqg-pos --ts 0.000125 -o lqg-pos.json\n"
                "  servotwin tune table-5.1 --structure hinf-load -o hinf-load.json\n"
+               "  servotwin tune table-5.1 --structure lqg-load --ts 0.000125 -o lqg-load.json\n"
                "  servotwin tune plant_model.json --delay 0.0005 --w2-num 2.6,0 --w2-den 1,15 --ms 1.6\n");
   add_tune_compare(*cmd, selected);
   cmd->callback([a, cmd, &selected] {

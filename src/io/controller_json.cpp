@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <span>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -33,16 +34,27 @@ constexpr double kRelTol = 1e-6;
 constexpr std::array<const char*, 2> kInputNames = {"velocity_reference", "motor_velocity"};
 constexpr std::array<const char*, 2> kPositionInputNames = {"position_reference", "motor_position"};
 constexpr std::array<const char*, 2> kLoadInputNames = {"velocity_reference", "load_velocity"};
+constexpr std::array<const char*, 3> kBothInputNames = {"velocity_reference", "motor_velocity", "load_velocity"};
 
 /// The controller's inputs: [ω*, ωm], [φ*, φm] for a full-order position controller, [ω*, ωl] for a
-/// load-measuring one.
-const std::array<const char*, 2>& input_names(Structure s) {
+/// load-measuring one, [ω*, ωm, ωl] for one measuring both (C7.17's LQG).
+std::span<const char* const> input_names(Structure s) {
+  if (tuning::measures_both(s)) return kBothInputNames;
   if (tuning::measures_load(s)) return kLoadInputNames;
   return tuning::is_position_controller(s) ? kPositionInputNames : kInputNames;
 }
 
-/// What the controller measures: "motor", or "load" (C7.17).
-std::string feedback_name(Structure s) { return tuning::measures_load(s) ? "load" : "motor"; }
+json input_names_json(Structure s) {
+  json names = json::array();
+  for (const char* name : input_names(s)) names.push_back(name);
+  return names;
+}
+
+/// What the controller measures: "motor", "load" or "both" (C7.17).
+std::string feedback_name(Structure s) {
+  if (tuning::measures_both(s)) return "both";
+  return tuning::measures_load(s) ? "load" : "motor";
+}
 
 std::string show(double v) { return fmt::format("{:.9g}", v); }
 
@@ -190,7 +202,7 @@ json position_json(const tuning::Controller& c, double omega_z) {
 }
 
 json state_space_json(const core::StateSpace& ss, const std::string& section, Structure structure) {
-  return {{"inputs", input_names(structure)},
+  return {{"inputs", input_names_json(structure)},
           {"output", "torque"},
           {"A", matrix_json(ss.A, section + ".A")},
           {"B", matrix_json(ss.B, section + ".B")},
@@ -346,27 +358,29 @@ Eigen::MatrixXd read_matrix(const Section& s, std::string_view key, Eigen::Index
   return out;
 }
 
-/// A, B, C, D of a controller with the two inputs and one output.
-void read_matrices(const Section& s, Eigen::MatrixXd& a, Eigen::MatrixXd& b, Eigen::MatrixXd& c, Eigen::MatrixXd& d) {
+/// A, B, C, D of a controller with the structure's inputs and one output.
+void read_matrices(const Section& s, Structure structure, Eigen::MatrixXd& a, Eigen::MatrixXd& b, Eigen::MatrixXd& c,
+                   Eigen::MatrixXd& d) {
+  const auto inputs = static_cast<Eigen::Index>(input_names(structure).size());
   a = read_matrix(s, "A", -1, -1);
   if (a.rows() != a.cols())
     s.fail("A", "expected a square matrix, got " + std::to_string(a.rows()) + "x" + std::to_string(a.cols()));
-  b = read_matrix(s, "B", a.rows(), 2);
+  b = read_matrix(s, "B", a.rows(), inputs);
   c = read_matrix(s, "C", 1, a.rows());
-  d = read_matrix(s, "D", 1, 2);
+  d = read_matrix(s, "D", 1, inputs);
 }
 
 /// The file's system must have the response of the system the gains define at every `omegas`
 /// (rad/s): relative to the larger channel, so a channel that is (nearly) zero is judged against
-/// the other. `response(sys, ω)` evaluates a 1×2 response.
+/// the others. `response(sys, ω)` evaluates a 1×(inputs) response.
 template <typename System, typename Response>
 void check_realization(const Section& parent, std::string_view key, const System& file, const System& expected,
                        const std::vector<double>& omegas, Response response, Structure structure) {
   for (double w : omegas) {
     const Eigen::MatrixXcd g = response(file, w);
     const Eigen::MatrixXcd e = response(expected, w);
-    const double scale = std::max(std::abs(e(0, 0)), std::abs(e(0, 1)));
-    for (Eigen::Index k = 0; k < 2; ++k) {
+    const double scale = e.row(0).cwiseAbs().maxCoeff();
+    for (Eigen::Index k = 0; k < e.cols(); ++k) {
       const std::complex<double> diff = g(0, k) - e(0, k);
       if (!(std::abs(diff) <= kRelTol * scale))
         parent.fail(key, fmt::format("does not realize the controller of \"gains\": at {} Hz the response from {} is "
@@ -615,12 +629,12 @@ std::vector<double> continuous_check_frequencies(double omega_z, const tuning::P
 core::StateSpace read_controller_matrices(const Section& s, Structure structure) {
   s.object.allow_only({"inputs", "output", "A", "B", "C", "D"});
   const json& inputs = s.raw("inputs");
-  if (inputs != json(input_names(structure)))
-    s.fail("inputs", "expected " + json(input_names(structure)).dump() + " for a \"" + to_string(structure) +
+  if (inputs != input_names_json(structure))
+    s.fail("inputs", "expected " + input_names_json(structure).dump() + " for a \"" + to_string(structure) +
                          "\" controller, got " + inputs.dump());
   s.expect_string("output", "torque");
   core::StateSpace out;
-  read_matrices(s, out.A, out.B, out.C, out.D);
+  read_matrices(s, structure, out.A, out.B, out.C, out.D);
   return out;
 }
 
@@ -648,7 +662,7 @@ std::optional<core::DiscreteStateSpace> read_discrete(const Section& root, const
   }
   core::DiscreteStateSpace file;
   file.ts = ts;
-  read_matrices(s, file.A, file.B, file.C, file.D);
+  read_matrices(s, c.structure, file.A, file.B, file.C, file.D);
   const core::DiscreteStateSpace expected = tuning::discretize_controller(c, ts, prewarp_rad_s);
   std::vector<double> omegas;
   for (double k : {1e-3, 1e-2, 0.1, 0.3, 0.6, 0.9}) omegas.push_back(k * kTwoPi * nyquist_hz);
@@ -791,10 +805,10 @@ tuning::FullOrderSummary read_position_lqg(const Section& s, Structure structure
 }
 
 /// The "lqg" section: null for the cascade structures, the compensator and its weights for lqg,
-/// lqg+p and lqg-pos.
+/// lqg+p, lqg-pos and lqg-load.
 std::optional<tuning::FullOrderSummary> read_lqg(const Section& root, Structure structure) {
-  const bool wanted = structure == Structure::kLqg || structure == Structure::kLqgP || structure == Structure::kLqgPos;
-  if (!section_present(root, "lqg", wanted, "lqg, lqg+p and lqg-pos", structure)) return std::nullopt;
+  if (!section_present(root, "lqg", tuning::is_lqg(structure), "lqg, lqg+p, lqg-pos and lqg-load", structure))
+    return std::nullopt;
   const Section s = root.section("lqg");
   if (structure == Structure::kLqgPos) return read_position_lqg(s, structure);
   s.object.allow_only({"kbw", "kbw_source", "feedforward", "feedforward_source", "q_load_velocity", "q_integral",
@@ -812,6 +826,8 @@ std::optional<tuning::FullOrderSummary> read_lqg(const Section& root, Structure 
   w.noise_load_torque = s.non_negative("noise_load_torque", "a noise intensity");
   w.measurement_noise = s.positive("measurement_noise", "a noise intensity");
   w.raw_motor_velocity = s.boolean("raw_motor_velocity");
+  if (w.raw_motor_velocity && tuning::measures_both(structure))
+    s.fail("raw_motor_velocity", "expected false: the load-side LQG (C7.17) regulates the estimated motor velocity");
   read_compensator(s, f, structure);
   return f;
 }
@@ -904,7 +920,7 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
   const std::string structure = root.object.string("structure");
   const auto parsed = tuning::structure_from_string(structure);
   if (!parsed)
-    root.fail("structure", "expected \"pi\", \"pid\", \"pi+p\", \"lqg\", \"lqg+p\", \"hinf\", \"lqg-pos\", \"hinf-pos\" or \"hinf-load\", got \"" +
+    root.fail("structure", "expected \"pi\", \"pid\", \"pi+p\", \"lqg\", \"lqg+p\", \"hinf\", \"lqg-pos\", \"hinf-pos\", \"hinf-load\" or \"lqg-load\", got \"" +
                                structure + "\"");
   c.structure = *parsed;
   const std::string loop = root.object.string("loop");

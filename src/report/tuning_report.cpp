@@ -573,7 +573,10 @@ Section loop_section(const Context& c, const tuning::VelocityLoop& loop) {
       "reference, the load velocity per load torque (closed loop against the uncontrolled plant: J2's "
       "reference) and the feedback controller C(s). Peaks and margins are the analysis' values (grid plus "
       "refinement).";
-  if (tuning::measures_load(c.controller.structure))
+  if (tuning::measures_both(c.controller.structure))
+    s.text += " The controller measures BOTH velocities (C7.17's LQG): L = (Cm·Pm + Cl·Pl), broken at the torque, so "
+              "S, T and the margins are those of that one loop; C(s) is the motor channel Cm.";
+  else if (tuning::measures_load(c.controller.structure))
     s.text += " The controller measures the LOAD velocity (C7.17): L = C·Pl, so S, T and the margins are those of the "
               "load loop; the load-torque response of ωl is its open-loop one times S.";
   if (c.position())

@@ -29,13 +29,15 @@ std::string to_string(Structure structure) {
       return "hinf-pos";
     case Structure::kHinfLoad:
       return "hinf-load";
+    case Structure::kLqgLoad:
+      return "lqg-load";
   }
   return "pi";
 }
 
 bool is_full_order(Structure structure) noexcept {
   return structure == Structure::kLqg || structure == Structure::kLqgP || structure == Structure::kHinf ||
-         structure == Structure::kHinfLoad || is_position_controller(structure);
+         structure == Structure::kHinfLoad || structure == Structure::kLqgLoad || is_position_controller(structure);
 }
 
 bool has_position_loop(Structure structure) noexcept {
@@ -54,11 +56,20 @@ bool is_hinf(Structure structure) noexcept {
   return structure == Structure::kHinf || structure == Structure::kHinfPos || structure == Structure::kHinfLoad;
 }
 
-bool measures_load(Structure structure) noexcept { return structure == Structure::kHinfLoad; }
+bool measures_load(Structure structure) noexcept {
+  return structure == Structure::kHinfLoad || structure == Structure::kLqgLoad;
+}
+
+bool measures_both(Structure structure) noexcept { return structure == Structure::kLqgLoad; }
+
+bool is_lqg(Structure structure) noexcept {
+  return structure == Structure::kLqg || structure == Structure::kLqgP || structure == Structure::kLqgPos ||
+         structure == Structure::kLqgLoad;
+}
 
 std::optional<Structure> structure_from_string(const std::string& name) {
   for (Structure s : {Structure::kPi, Structure::kPid, Structure::kPiP, Structure::kLqg, Structure::kLqgP, Structure::kHinf,
-                      Structure::kLqgPos, Structure::kHinfPos, Structure::kHinfLoad}) {
+                      Structure::kLqgPos, Structure::kHinfPos, Structure::kHinfLoad, Structure::kLqgLoad}) {
     if (to_string(s) == name) return s;
   }
   return std::nullopt;
@@ -110,12 +121,16 @@ ControllerTf normalized_controller(const Controller& c) {
 }
 
 ControllerTf compensator_form(Structure structure, const core::StateSpace& compensator) {
+  if (measures_both(structure))
+    throw std::invalid_argument("compensator_form: " + to_string(structure) + " has three inputs (use compensator_loop)");
   const ControllerTf tf = two_dof_form(compensator);
   return is_position_controller(structure) ? velocity_form(tf) : tf;
 }
 
 VelocityLoop compensator_loop(const NormalizedPlant& plant, Structure structure, const core::StateSpace& compensator,
                               bool with_hf, bool with_higher_modes) {
+  if (measures_both(structure))
+    return VelocityLoop::two_measurements(plant.first_mode(), two_measurement_form(compensator), with_hf);
   const ControllerTf tf = compensator_form(structure, compensator);
   if (measures_load(structure)) return VelocityLoop::load_feedback(plant.first_mode(), tf, with_hf);
   return VelocityLoop(plant, tf, with_hf, with_higher_modes);

@@ -422,19 +422,22 @@ struct LqgModel {
   std::vector<fit::Mode> modes;
 };
 
-/// The C7.13 velocity LQG of the user's weights at one (kbw, kff), and its loop.
+/// The C7.13 velocity LQG (or C7.17's load-side LQG for lqg-load) of the user's weights at one
+/// (kbw, kff), and its loop.
 struct LqgDesigner {
   const NormalizedPlant& plant;
   const LqgModel& model;
   VelocityLqgOptions weights;
+  Structure structure = Structure::kLqg;
 
   [[nodiscard]] LqgDesign design(double kbw, double kff) const {
     VelocityLqgOptions w = weights;
     w.kbw = kbw;
     w.feedforward = kff;
+    if (measures_load(structure)) return load_side_lqg(model.two_mass, plant.r, w);
     return velocity_lqg(model.two_mass, model.modes, plant.r, w);
   }
-  [[nodiscard]] VelocityLoop loop(const LqgDesign& d) const { return compensator_loop(plant, Structure::kLqg, d.compensator); }
+  [[nodiscard]] VelocityLoop loop(const LqgDesign& d) const { return compensator_loop(plant, structure, d.compensator); }
 };
 
 /// The LQG's design model: the first mode's two-mass realization with friction, extended by the
@@ -538,7 +541,7 @@ void search_raising_noise(double& v, const TuneOptions& options, TuneResult& res
 void choose_kbw(const NormalizedPlant& plant, const LqgModel& model, const TuneOptions& options,
                 const SpecCheck& check, FullOrderSummary& f, TuneResult& result) {
   search_raising_noise(f.weights.measurement_noise, options, result, [&] {
-    const LqgDesigner lqg{plant, model, f.weights};
+    const LqgDesigner lqg{plant, model, f.weights, options.structure};
     const std::optional<double> kbw = automatic_kbw(lqg, check, options.feedforward, result.scan);
     if (kbw) f.weights.kbw = *kbw;
     return kbw.has_value();
@@ -579,9 +582,24 @@ VelocityLoop finish_full_order(TuneResult& result, const TuneOptions& options, c
   return loop;
 }
 
+/// A load-measuring design (C7.17) needs the load of a two-mass plant.
+void require_two_mass_load(const NormalizedPlant& plant, Structure structure) {
+  if (plant.higher_modes.empty() && two_mass_realization(plant)) return;
+  const std::string motor_side = is_hinf(structure) ? "hinf" : "lqg";
+  throw InputError(at_field("--structure"),
+                   plant.higher_modes.empty()
+                       ? fmt::format("{} measures the load of the two-mass realization, and this plant has none (its "
+                                     "shaft damping would be negative); use --structure {}",
+                                     to_string(structure), motor_side)
+                       : fmt::format("{} (C7.17) needs a two-mass plant; this one has {} higher mode(s): use "
+                                     "--structure {} (motor feedback, C7.16)",
+                                     to_string(structure), plant.higher_modes.size(), motor_side));
+}
+
 /// The LQG path of tune(): kbw and kff, the compensator, its analysis and robustness.
 void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
   const NormalizedPlant& plant = result.plant;
+  if (measures_load(options.structure)) require_two_mass_load(plant, options.structure);
   const LqgModel model = lqg_design_model(plant, options);
   Controller& c = result.controller;
   FullOrderSummary f;
@@ -592,7 +610,7 @@ void tune_lqg(TuneResult& result, const TuneOptions& options, const SpecCheck& c
   } else {
     choose_kbw(plant, model, options, check, f, result);
   }
-  const LqgDesigner lqg{plant, model, f.weights};
+  const LqgDesigner lqg{plant, model, f.weights, options.structure};
   if (options.feedforward) {
     f.weights.feedforward = *options.feedforward;
     f.feedforward_source = "given";
@@ -791,15 +809,7 @@ std::string higher_modes_note(const TuneOptions& o, const std::vector<fit::Mode>
 /// The hinf path of tune(): w0S and w0T, the compensator, its analysis and robustness.
 void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
   const NormalizedPlant& plant = result.plant;
-  if (measures_load(options.structure) && (!plant.higher_modes.empty() || !two_mass_realization(plant))) {
-    throw InputError(at_field("--structure"),
-                     plant.higher_modes.empty()
-                         ? "hinf-load measures the load of the two-mass realization, and this plant has none (its shaft "
-                           "damping would be negative); use --structure hinf"
-                         : fmt::format("hinf-load (C7.17) needs a two-mass plant; this one has {} higher mode(s): use "
-                                       "--structure hinf (motor feedback, C7.16)",
-                                       plant.higher_modes.size()));
-  }
+  if (measures_load(options.structure)) require_two_mass_load(plant, options.structure);
   // With the known HF dynamics; C7.16 decides on the modes.
   const HinfDesigner h{plant, options.hinf_modes == ModeHandling::kFirstMode ? plant.first_mode() : plant, options};
   HinfSummary s;
@@ -1019,8 +1029,7 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
   if (!plant.higher_modes.empty()) c.notes.push_back(higher_modes_note(options, plant.higher_modes));
   // The note matters where a load side is used: the loop's load numbers, the LQG's design model or
   // the position loop (both on the first mode's realization).
-  const bool lqg = options.structure == Structure::kLqg || options.structure == Structure::kLqgP ||
-                   options.structure == Structure::kLqgPos;
+  const bool lqg = is_lqg(options.structure);
   const bool uses_load =
       plant.load_estimate() || lqg || controls_position(options.structure) || measures_load(options.structure);
   if (const std::optional<std::string> note = estimated_load_note(plant); note && uses_load) c.notes.push_back(*note);

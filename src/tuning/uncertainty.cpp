@@ -390,7 +390,8 @@ RobustTracking robust_tracking(const VelocityLoop& loop, const TransferFunction&
   }
   // Finite on the whole grid: |W2 T| < 1 everywhere (its refined supremum is).
   const auto bound = [&](double w) {
-    const double gain = std::abs(loop.motor_tracking(w)) * (1.0 + std::abs(w2.frequency_response(w))) /
+    const std::complex<double> tracking = loop.measures_load() ? loop.load_tracking(w) : loop.motor_tracking(w);
+    const double gain = std::abs(tracking) * (1.0 + std::abs(w2.frequency_response(w))) /
                         (1.0 - std::abs(wt(w)));
     return std::complex<double>(gain / mt, 0.0);
   };

@@ -55,11 +55,19 @@ bool is_load_output(machine::PlantOutput o) {
 /// plant that measures the motor is run with its encoder moved to the load (a note says so).
 machine::PlantConfig as_measured(const machine::PlantConfig& plant, const tuning::Controller& controller,
                                  std::vector<std::string>& notes) {
-  if (!tuning::measures_load(controller.structure) || is_load_output(plant.settings.output)) return plant;
+  if (!tuning::measures_load(controller.structure)) return plant;
   const auto* chain = std::get_if<machine::MassChain>(&plant.model);
   if (!chain || chain->masses() < 2)
     fail("model", "a mass chain with a load for the " + tuning::to_string(controller.structure) +
                       " controller, which measures the load");
+  if (tuning::measures_both(controller.structure)) {
+    notes.push_back(fmt::format("the controller measures both velocities: the plant's sensor reads the {}, a second "
+                                "encoder of the same resolution (no noise) the {} side",
+                                machine::to_string(plant.settings.output),
+                                is_load_output(plant.settings.output) ? "motor" : "load"));
+    return plant;
+  }
+  if (is_load_output(plant.settings.output)) return plant;
   machine::PlantConfig moved = plant;
   moved.settings.output = is_position_output(plant.settings.output) ? machine::PlantOutput::LoadPosition
                                                                     : machine::PlantOutput::LoadVelocity;
@@ -111,15 +119,44 @@ class FeedbackReader {
   double position_;
 };
 
-/// The discrete 2-DoF controller with inputs [ω*, ωm], its torque limit and conditional integration.
+/// The plant's sensor on the other side of the shaft, for a controller measuring both velocities:
+/// the true motor or load signal of the same kind (velocity or position), quantized like the sensor.
+class SecondEncoder {
+ public:
+  explicit SecondEncoder(const machine::PlantSettings& s)
+      : load_(!is_load_output(s.output)), position_(is_position_output(s.output)), q_(s.quantization) {}
+
+  [[nodiscard]] double read(const machine::PlantMeasurement& m) const noexcept {
+    const double exact = load_ ? (position_ ? m.load_position : m.load_velocity)
+                               : (position_ ? m.motor_position : m.motor_velocity);
+    return q_ > 0.0 ? q_ * std::round(exact / q_) : exact;
+  }
+  /// True when it reads the load (the plant's sensor the motor).
+  [[nodiscard]] bool reads_load() const noexcept { return load_; }
+  /// What it reads, as a plant output.
+  [[nodiscard]] machine::PlantOutput output() const noexcept {
+    using machine::PlantOutput;
+    if (load_) return position_ ? PlantOutput::LoadPosition : PlantOutput::LoadVelocity;
+    return position_ ? PlantOutput::MotorPosition : PlantOutput::MotorVelocity;
+  }
+
+ private:
+  bool load_, position_;
+  double q_;
+};
+
+/// The discrete controller with inputs [ω*, y] or [ω*, ωm, ωl], its torque limit and conditional
+/// integration.
 class LimitedController {
  public:
   LimitedController(const core::DiscreteStateSpace& c, std::optional<double> limit)
-      : c_(c), limit_(limit), x_(Eigen::VectorXd::Zero(c.states())), next_(x_) {}
+      : c_(c), limit_(limit), x_(Eigen::VectorXd::Zero(c.states())), next_(x_), both_(c.B.cols() == 3) {}
 
-  /// The torque command for this sample; advances the states unless the limit is active.
-  double update(double reference, double velocity) noexcept {
-    const double raw = c_.C.row(0).dot(x_) + c_.D(0, 0) * reference + c_.D(0, 1) * velocity;
+  /// The torque command for this sample; advances the states unless the limit is active. `load` is
+  /// read only by a controller with three inputs ([ω*, ωm, ωl]; `measured` is then ωm).
+  double update(double reference, double measured, double load = 0.0) noexcept {
+    double raw = c_.C.row(0).dot(x_) + c_.D(0, 0) * reference + c_.D(0, 1) * measured;
+    if (both_) raw += c_.D(0, 2) * load;
     double u = raw;
     limited_ = false;
     if (limit_ && std::abs(raw) > *limit_) {
@@ -128,7 +165,8 @@ class LimitedController {
     }
     if (!limited_) {
       next_.noalias() = c_.A * x_;
-      next_ += c_.B.col(0) * reference + c_.B.col(1) * velocity;
+      next_ += c_.B.col(0) * reference + c_.B.col(1) * measured;
+      if (both_) next_ += c_.B.col(2) * load;
       x_.swap(next_);
     }
     return u;
@@ -139,6 +177,7 @@ class LimitedController {
   const core::DiscreteStateSpace& c_;
   std::optional<double> limit_;
   Eigen::VectorXd x_, next_;
+  bool both_;
   bool limited_ = false;
 };
 
@@ -150,10 +189,11 @@ struct LoopRun {
 double reference_of(DriveTest test, double amplitude) { return test == DriveTest::kSetpointStep ? amplitude : 0.0; }
 
 /// What the discrete controller reads: [ω*, ωm] (velocity loop, with ω* = kpp (φ* − φm) under a P
-/// position loop) or [φ*, φm] (a full-order position controller).
+/// position loop), [φ*, φm] (a full-order position controller) or [ω*, ωm, ωl] (both measured).
 struct ControllerInputs {
   std::optional<double> kpp;
   bool position = false;
+  bool both = false;
 };
 
 LoopRun run_loop(const machine::PlantConfig& config, const core::DiscreteStateSpace& controller,
@@ -168,16 +208,26 @@ LoopRun run_loop(const machine::PlantConfig& config, const core::DiscreteStateSp
   const bool tf_plant = !std::holds_alternative<machine::MassChain>(config.model);
   FeedbackReader exact(config.settings.output, ts, m.y_exact);
   LimitedController velocity_controller(controller, limit);
+  const SecondEncoder second_encoder(config.settings);
+  FeedbackReader second(second_encoder.output(), ts, second_encoder.read(m));
   const double reference = reference_of(test, amplitude);
   const double load_torque = test == DriveTest::kLoadStep ? amplitude : 0.0;
   LoopRun run;
   run.samples.reserve(steps);
   for (std::size_t k = 0; k < steps; ++k) {
     feedback.read(m.y);
-    const double u =
-        inputs.position ? velocity_controller.update(reference, feedback.position())
-                        : velocity_controller.update(inputs.kpp ? *inputs.kpp * (reference - feedback.position()) : reference,
-                                                     feedback.velocity());
+    double u = 0.0;
+    if (inputs.both) {
+      second.read(second_encoder.read(m));
+      const bool motor_first = second_encoder.reads_load();
+      u = velocity_controller.update(reference, motor_first ? feedback.velocity() : second.velocity(),
+                                     motor_first ? second.velocity() : feedback.velocity());
+    } else {
+      u = inputs.position ? velocity_controller.update(reference, feedback.position())
+                          : velocity_controller.update(
+                                inputs.kpp ? *inputs.kpp * (reference - feedback.position()) : reference,
+                                feedback.velocity());
+    }
     run.limited += velocity_controller.limited() ? 1 : 0;
     DriveSample s;
     s.t = static_cast<double>(k) * ts;
@@ -379,7 +429,8 @@ DriveSimulation simulate_drive(const machine::PlantConfig& given_plant, const tu
   out.controller = tuning::discretize_controller(controller, out.ts, usable_prewarp(controller, out.ts, out.notes));
 
   const ControllerInputs inputs{is_position_loop(controller) ? controller.kpp_physical : std::nullopt,
-                                tuning::is_position_controller(controller.structure)};
+                                tuning::is_position_controller(controller.structure),
+                                tuning::measures_both(controller.structure)};
   out.kpp = inputs.kpp;
   const Selector select = controlled_variable(out);
   const machine::PlantConfig linear_plant = linear_part(plant);

@@ -133,21 +133,35 @@ TEST_F(Cli, TuneTheFullPositionLqgAndSimulateAPositionStep) {
   EXPECT_NE(frame.err.find("closes a position loop"), std::string::npos) << frame.err;
 }
 
-TEST_F(Cli, TuneTheLoadMeasuringHinfAndSimulateIt) {
-  // C7.17: the load velocity measured. The tuner says where the search stopped, the file says
-  // "feedback": "load", and simulate moves the preset's encoder to the load and reaches ω*.
-  const Result t = run("tune table-5.1 --structure hinf-load -o hl.json");
-  ASSERT_EQ(t.status, 0) << t.err;
-  EXPECT_NE(t.out.find("velocity, load measured loop (C7.17"), std::string::npos) << t.out;
-  EXPECT_NE(slurp(path("hl.json")).find("\"feedback\": \"load\""), std::string::npos);
-  const Result r = run("simulate --controller hl.json --duration 20 -o hl.csv");
-  ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.out.find("moved from motor_velocity to load_velocity"), std::string::npos) << r.out;
-  const auto cells = last_row(slurp(path("hl.csv")));
-  ASSERT_EQ(cells.size(), 14U);
-  EXPECT_NEAR(std::stod(cells[5]), 1.0, 0.01);  // load velocity at the reference
-  const Result compare = run("tune compare table-5.1 --structures pi,hinf-load");
-  EXPECT_NE(compare.status, 0);
+TEST_F(Cli, TuneTheLoadMeasuringControllersAndSimulateThem) {
+  // C7.17: the load velocity measured (hinf-load), or both velocities (lqg-load). The tuner names
+  // the design, the file says what is fed back, and simulate moves the preset's encoder to the
+  // load (hinf-load) or adds a load encoder (lqg-load) and reaches ω*.
+  struct Case {
+    const char* structure;
+    const char* summary;
+    const char* feedback;
+    const char* simulation_note;
+  };
+  for (const Case c : {Case{"hinf-load", "velocity, load measured loop (C7.17", "\"feedback\": \"load\"",
+                            "moved from motor_velocity to load_velocity"},
+                       Case{"lqg-load", "LQG velocity loop (C7.17, integral on the load, motor and load velocity measured",
+                            "\"feedback\": \"both\"", "a second encoder of the same resolution (no noise) the load side"}}) {
+    SCOPED_TRACE(c.structure);
+    const std::string file = std::string(c.structure) + ".json", csv = std::string(c.structure) + ".csv";
+    const Result t = run("tune table-5.1 --structure " + std::string(c.structure) + " -o " + file);
+    ASSERT_EQ(t.status, 0) << t.err;
+    EXPECT_NE(t.out.find(c.summary), std::string::npos) << t.out;
+    EXPECT_NE(slurp(path(file)).find(c.feedback), std::string::npos);
+    const Result r = run("simulate --controller " + file + " --duration 20 -o " + csv);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find(c.simulation_note), std::string::npos) << r.out;
+    const auto cells = last_row(slurp(path(csv)));
+    ASSERT_EQ(cells.size(), 14U);
+    EXPECT_NEAR(std::stod(cells[5]), 1.0, 0.01);  // load velocity at the reference
+    const Result compare = run("tune compare table-5.1 --structures pi," + std::string(c.structure));
+    EXPECT_NE(compare.status, 0);
+  }
 }
 
 TEST_F(Cli, SimulateLoadStepWithATorqueLimit) {

@@ -624,7 +624,7 @@ TEST_F(ControllerJsonErrors, SamplePeriodAndPrewarp) {
 }
 
 TEST_F(ControllerJsonErrors, StructureAndLoop) {
-  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"hinf-pos\" or \"hinf-load\"");
+  expect(with([](auto& c) { c["structure"] = "PI"; }), "structure", "\"hinf-load\" or \"lqg-load\"");
   expect(with([](auto& c) { c["position"]["kpp"] = 1.0; c["position"]["kpp_normalized"] = 1.0; }, Structure::kPiP),
          "position.kpp", "de-normalized");
   expect(with([](auto& c) { c["structure"] = "lqg"; }), "gains", "expected null for an \"lqg\" controller");
@@ -680,7 +680,7 @@ TEST_F(ControllerJsonErrors, LqgDocuments) {
          "velocity_reference");
   expect(edited([](auto& c) { c["design"]["omega_star"] = 0.5; }), "design.omega_star", "expected null");
   expect(edited([](auto& c) { c["gains"] = c["state_space"]; }), "gains", "expected null");
-  expect(with([](auto& c) { c["lqg"] = {{"kbw", 1.0}}; }), "lqg", "only lqg, lqg+p and lqg-pos controllers");
+  expect(with([](auto& c) { c["lqg"] = {{"kbw", 1.0}}; }), "lqg", "only lqg, lqg+p, lqg-pos and lqg-load controllers");
 }
 
 TEST(ControllerJsonRoundTrip, HinfFromTheTuner) {
@@ -743,7 +743,7 @@ TEST_F(ControllerJsonErrors, HinfDocuments) {
                 c["hinf"].erase(k);
             }).message,
             "no error");
-  expect(edited([](auto& c) { c["lqg"] = c["hinf"]; }), "lqg", "only lqg, lqg+p and lqg-pos controllers");
+  expect(edited([](auto& c) { c["lqg"] = c["hinf"]; }), "lqg", "only lqg, lqg+p, lqg-pos and lqg-load controllers");
   expect(with([](auto& c) { c["hinf"] = {{"omega_0s", 1.0}}; }), "hinf", "only hinf and hinf-pos controllers");
 }
 
@@ -794,6 +794,29 @@ TEST(ControllerJsonRoundTrip, LoadMeasuringHinf) {
   nlohmann::json motor = j;
   motor["feedback"] = "motor";
   EXPECT_EQ(error_of(motor.dump()).field, "feedback");
+}
+
+TEST_F(ControllerJsonErrors, LoadSideLqgMeasuringBothVelocities) {
+  // lqg-load: "feedback": "both", inputs [velocity_reference, motor_velocity, load_velocity]; the
+  // third channel of the physical state space is checked like the others.
+  const Controller c = full_order_controller(Structure::kLqgLoad);
+  const nlohmann::json j = controller_to_json(c, "two_mass.json");
+  EXPECT_EQ(j["feedback"], "both");
+  EXPECT_EQ(j["state_space"]["inputs"], nlohmann::json({"velocity_reference", "motor_velocity", "load_velocity"}));
+  EXPECT_EQ(j["discrete"]["B"][0].size(), 3u);
+  expect_round_trip(c, parse_controller_json(j.dump(), "lqg-load.json").controller);
+  const auto edited = [&](auto edit) { return edited_copy(j, edit); };
+  expect(edited([](auto& d) { d["feedback"] = "load"; }), "feedback", "\"both\"");
+  expect(edited([](auto& d) { d["state_space"]["inputs"] = {"velocity_reference", "load_velocity"}; }),
+         "state_space.inputs", "motor_velocity");
+  expect(edited([](auto& d) {
+           for (auto& row : d["state_space"]["B"]) row[2] = 1.01 * row[2].template get<double>();
+         }),
+         "state_space", "from load_velocity");
+  expect(edited([](auto& d) { d["discrete"]["D"][0][2] = 2.0 * d["discrete"]["D"][0][2].template get<double>(); }),
+         "discrete", "from load_velocity");
+  expect(edited([](auto& d) { d["lqg"]["compensator"]["B"][0].erase(2); }), "lqg.compensator.B", "3");
+  expect(edited([](auto& d) { d["lqg"]["raw_motor_velocity"] = true; }), "lqg.raw_motor_velocity", "expected false");
 }
 
 TEST_F(ControllerJsonErrors, PositionControllerDocuments) {

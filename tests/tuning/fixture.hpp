@@ -94,6 +94,21 @@ inline core::StateSpace closed_loop_ss(const core::StateSpace& p, const core::St
   return cl;
 }
 
+/// The same for a compensator measuring both outputs of p (inputs [reference, ωm, ωl], C7.17's
+/// LQG): u = Cc xc + D [reference, ωm, ωl]; inputs [reference, Tl], outputs p's.
+inline core::StateSpace two_measurement_closed_loop_ss(const core::StateSpace& p, const core::StateSpace& k) {
+  const Eigen::Index n = p.A.rows(), q = k.A.rows();
+  core::StateSpace cl;
+  cl.A.resize(n + q, n + q);
+  cl.A << p.A + p.B.col(0) * k.D.rightCols(2) * p.C, p.B.col(0) * k.C, k.B.rightCols(2) * p.C, k.A;
+  cl.B.resize(n + q, 2);
+  cl.B << p.B.col(0) * k.D(0, 0), p.B.col(1), k.B.col(0), Eigen::MatrixXd::Zero(q, 1);
+  cl.C = Eigen::MatrixXd::Zero(p.C.rows(), n + q);
+  cl.C.leftCols(n) = p.C;
+  cl.D = Eigen::MatrixXd::Zero(p.C.rows(), 2);
+  return cl;
+}
+
 /// The position plant p (outputs [φm, φl]) under a position compensator (inputs [φ*, φm]).
 inline core::StateSpace position_closed_loop_ss(const core::StateSpace& p, const core::StateSpace& k) {
   return closed_loop_ss(p, k, 0);

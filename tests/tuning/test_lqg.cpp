@@ -294,17 +294,7 @@ TEST(Lqg, LoadSideLoopWithBothMeasurementsHasScipysPolesAndTheStateSpaceResponse
   for (const auto& p : roots_of(c.at("kf_poles"))) expected.push_back(p);
   expect_same_roots(loop.characteristic_polynomial().roots(), expected, 1e-6, "loop");
   // The state-space loop: u = Cc xc + D [w*, wm, wl], plant outputs [wm, wl], inputs [Tm, Tl].
-  const core::StateSpace p = two_mass_state_space(m, false);
-  const core::StateSpace& k = d.compensator;
-  const Eigen::Index n = p.A.rows(), q = k.A.rows();
-  core::StateSpace cl;
-  cl.A.resize(n + q, n + q);
-  cl.A << p.A + p.B.col(0) * k.D.rightCols(2) * p.C, p.B.col(0) * k.C, k.B.rightCols(2) * p.C, k.A;
-  cl.B.resize(n + q, 2);
-  cl.B << p.B.col(0) * k.D(0, 0), p.B.col(1), k.B.col(0), Eigen::MatrixXd::Zero(q, 1);
-  cl.C = Eigen::MatrixXd::Zero(2, n + q);
-  cl.C.leftCols(n) = p.C;
-  cl.D = Eigen::MatrixXd::Zero(2, 2);
+  const core::StateSpace cl = test::two_measurement_closed_loop_ss(two_mass_state_space(m, false), d.compensator);
   for (const double w : {0.01, 0.3, 1.0, 2.9, 10.0}) {
     const auto close = [&](std::complex<double> got, Eigen::Index out, Eigen::Index in, const char* what) {
       const std::complex<double> want = core::frequency_response(cl, w, out, in);

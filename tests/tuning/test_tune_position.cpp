@@ -223,6 +223,56 @@ TEST(TuneLoadFeedback, HinfLoadIsTheC717DesignAndItsLoopIsTheLoadMeasured) {
       [&] { (void)compare_structures(model, TuneOptions{}, {Structure::kHinfLoad}); }, "structures", "measures the load");
 }
 
+TEST(TuneLoadFeedback, LqgLoadIsC717sLqgAndItsLoopIsBothVelocitiesMeasured) {
+  // lqg-load: C7.17's load-side LQG (integral on ωl, Kalman filter on [ωm, ωl]) at the chosen kbw
+  // and feedforward; its loop checked on the closed loop written out in state space with both
+  // velocities fed back (test::two_measurement_closed_loop_ss, independent of the transfer-
+  // function route the tuner analyses): load tracking and load-torque response, −3 dB at the
+  // predicted load bandwidth, unit DC gain and a load torque rejected from ωl at DC.
+  const fit::PlantModel model = test::two_mass_model(3.0, 0.01);
+  const TuneResult result = tune(model, position_options(Structure::kLqgLoad));
+  const Controller& c = result.controller;
+  ASSERT_TRUE(c.full_order && !c.full_order->hinf);
+  const FrictionTwoMass m = *two_mass_realization(result.plant);
+  const core::StateSpace k = load_side_lqg(m, result.plant.r, c.full_order->weights).compensator;
+  ASSERT_EQ(c.full_order->compensator.B.cols(), 3);
+  for (const double x : {0.05, 0.5, 2.0})
+    for (Eigen::Index i = 0; i < 3; ++i)
+      EXPECT_LT(std::abs(core::frequency_response(c.full_order->compensator, x, 0, i) - core::frequency_response(k, x, 0, i)),
+                1e-9 * std::abs(core::frequency_response(k, x, 0, i)));
+  const core::StateSpace cl = test::two_measurement_closed_loop_ss(two_mass_state_space(m, false), k);
+  const VelocityLoop loop = controller_loop(result.plant, c);
+  ASSERT_TRUE(loop.measures_both());
+  for (const double x : {0.01, 0.3, 1.0, 3.0, 10.0}) {
+    const Complex direct = core::frequency_response(cl, x, 1, 0);
+    EXPECT_LT(std::abs(loop.load_tracking(x) - direct), 1e-8 * std::abs(direct)) << x;
+    const Complex torque = core::frequency_response(cl, x, 1, 1);
+    EXPECT_LT(std::abs(loop.load_from_load_torque(x) - torque), 1e-8 * std::abs(torque) + 1e-12) << x;
+  }
+  EXPECT_NEAR(std::abs(core::frequency_response(cl, c.predicted.bandwidth_load, 1, 0)), std::pow(10.0, -3.0 / 20.0), 1e-6);
+  EXPECT_NEAR(std::abs(core::frequency_response(cl, 1e-7, 1, 0)), 1.0, 1e-6);
+  EXPECT_LT(std::abs(core::frequency_response(cl, 1e-10, 1, 1)), 1e-6);
+  // The spec holds, and the automatic kbw stops where it binds (||S|| or the load tracking peak).
+  EXPECT_LE(c.predicted.peak_s, 1.5 * (1.0 + 1e-3));
+  EXPECT_LE(c.predicted.peak_tl, 1.5 * (1.0 + 1e-3));
+  EXPECT_GT(std::max(c.predicted.peak_s, c.predicted.peak_tl), 1.5 * (1.0 - 1e-2));
+  // C7.17: measuring the load is worth it. The motor-feedback LQG of the same spec on the same plant
+  // reaches a slower load.
+  const TuneResult motor = tune(model, position_options(Structure::kLqg));
+  EXPECT_GT(c.predicted.bandwidth_load, 2.0 * motor.controller.predicted.bandwidth_load);
+  // Refused where there is no two-mass load to measure, and by the motor-feedback comparison.
+  fit::PlantModel two_modes = model;
+  two_modes.modes.push_back({{8.0 * 2.0 * std::numbers::pi * 40.0, 0.01}, {10.0 * 2.0 * std::numbers::pi * 40.0, 0.02}});
+  test::expect_input_error([&] { (void)tune(two_modes, position_options(Structure::kLqgLoad)); }, "--structure",
+                           "lqg-load (C7.17) needs a two-mass plant");
+  test::expect_input_error(
+      [&] { (void)compare_structures(model, TuneOptions{}, {Structure::kLqgLoad}); }, "structures", "measures the load");
+  EXPECT_EQ(structure_from_string("lqg-load"), Structure::kLqgLoad);
+  EXPECT_TRUE(measures_both(Structure::kLqgLoad) && measures_load(Structure::kLqgLoad) && is_lqg(Structure::kLqgLoad));
+  EXPECT_FALSE(measures_both(Structure::kHinfLoad));
+  EXPECT_THROW((void)compensator_form(Structure::kLqgLoad, k), std::invalid_argument);
+}
+
 }  // namespace tune_position_test
 }  // namespace
 }  // namespace servotwin::tuning

@@ -202,6 +202,17 @@ TEST(DriveSimulation, PositionControllersFollowTheirContinuousLoopsInPhysicalUni
   }
 }
 
+/// A controller with integral action on the load velocity: after a load-torque step of 3 the load
+/// is back at rest and the motor torque balances the load torque (closed form).
+void expect_load_torque_rejected_from_the_load(const machine::PlantConfig& plant, const tuning::Controller& controller,
+                                               DriveSimulationSettings s) {
+  s.test = DriveTest::kLoadStep;
+  s.amplitude = 3.0;
+  const DriveSimulation disturbance = simulate_drive(plant, controller, s);
+  EXPECT_NEAR(disturbance.samples.back().load_velocity, 0.0, 1e-4);
+  EXPECT_NEAR(disturbance.samples.back().torque_command, 3.0, 1e-3);
+}
+
 TEST(DriveSimulation, LoadMeasuringControllerFollowsItsContinuousLoop) {
   // hinf-load (C7.17) reads the load velocity: the plant's encoder is moved to the load (with a
   // note), and the sampled loop follows the continuous load-feedback loop (VelocityLoop::
@@ -219,11 +230,36 @@ TEST(DriveSimulation, LoadMeasuringControllerFollowsItsContinuousLoop) {
   const auto load = core::step_response(*loop.load_tracking, dt_normalized, sim.samples.size());
   EXPECT_LT(max_difference(sim.samples, load, [](const DriveSample& x) { return x.load_velocity; }), 5e-3);
   EXPECT_NEAR(sim.samples.back().load_velocity, 1.0, 1e-4);
-  s.test = DriveTest::kLoadStep;
-  s.amplitude = 3.0;
-  const DriveSimulation disturbance = simulate_drive(plant, r.controller, s);
-  EXPECT_NEAR(disturbance.samples.back().load_velocity, 0.0, 1e-4);
-  EXPECT_NEAR(disturbance.samples.back().torque_command, 3.0, 1e-3);
+  expect_load_torque_rejected_from_the_load(plant, r.controller, s);
+}
+
+TEST(DriveSimulation, ControllerMeasuringBothVelocitiesFollowsItsContinuousLoop) {
+  // lqg-load (C7.17's LQG) reads [ω*, ωm, ωl]: the plant's sensor gives one of them and a second
+  // encoder the other side. The sampled loop follows the continuous two-measurement loop
+  // (VelocityLoop::two_measurements) in physical units whichever side the plant's sensor is on
+  // (the channels must not be swapped), and a load torque is rejected from ωl.
+  auto plant = scaled_plant();
+  const auto r = tuned(plant, tuning::Structure::kLqgLoad);
+  const auto loop = tuning::controller_loop(r.plant, r.controller, false).closed_loop();
+  DriveSimulationSettings s;
+  s.duration_s = 20.0;
+  const double dt_normalized = plant.settings.ts * r.controller.plant.omega_z;
+  for (const auto output : {machine::PlantOutput::MotorVelocity, machine::PlantOutput::LoadVelocity}) {
+    plant.settings.output = output;
+    const DriveSimulation sim = simulate_drive(plant, r.controller, s);
+    ASSERT_FALSE(sim.notes.empty());
+    EXPECT_NE(sim.notes.front().find("measures both velocities"), std::string::npos) << sim.notes.front();
+    const auto load = core::step_response(*loop.load_tracking, dt_normalized, sim.samples.size());
+    const auto motor = core::step_response(loop.motor_tracking, dt_normalized, sim.samples.size());
+    EXPECT_LT(max_difference(sim.samples, load, [](const DriveSample& x) { return x.load_velocity; }), 5e-3);
+    // The motor swings to about 19 times the step to whip the load through the shaft: 1 % of that.
+    const double motor_swing = *std::max_element(motor.begin(), motor.end());
+    EXPECT_GT(motor_swing, 10.0);
+    EXPECT_LT(max_difference(sim.samples, motor, [](const DriveSample& x) { return x.motor_velocity; }),
+              1e-2 * motor_swing);
+    EXPECT_NEAR(sim.samples.back().load_velocity, 1.0, 1e-4);
+  }
+  expect_load_torque_rejected_from_the_load(plant, r.controller, s);
 }
 
 TEST(DriveSimulation, IntegralActionRemovesCoulombFrictionAtConstantVelocity) {

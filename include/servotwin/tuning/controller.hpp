@@ -19,6 +19,8 @@
 ///             error; inputs [φ*, φm]) with the same kind of prefilter
 ///   hinf-load the H-infinity velocity controller of C7.17 measuring the LOAD velocity (inputs
 ///             [ω*, ωl]; a load encoder)
+///   lqg-load  the load-side LQG of C7.17: integral action on the load velocity, a Kalman filter
+///             measuring both velocities (inputs [ω*, ωm, ωl]; motor and load encoders)
 
 #include <optional>
 #include <string>
@@ -34,10 +36,10 @@
 namespace servotwin::tuning {
 
 /// Controller structure offered by the tuner.
-enum class Structure { kPi, kPid, kPiP, kLqg, kLqgP, kHinf, kLqgPos, kHinfPos, kHinfLoad };
+enum class Structure { kPi, kPid, kPiP, kLqg, kLqgP, kHinf, kLqgPos, kHinfPos, kHinfLoad, kLqgLoad };
 
 /// A structure whose controller is a general state space (no PID gains): lqg, lqg+p, hinf,
-/// lqg-pos, hinf-pos.
+/// lqg-pos, hinf-pos, hinf-load, lqg-load.
 [[nodiscard]] bool is_full_order(Structure structure) noexcept;
 
 /// A structure with a P position loop over its velocity loop: pi+p, lqg+p.
@@ -53,10 +55,16 @@ enum class Structure { kPi, kPid, kPiP, kLqg, kLqgP, kHinf, kLqgPos, kHinfPos, k
 /// An H-infinity structure: hinf, hinf-pos, hinf-load.
 [[nodiscard]] bool is_hinf(Structure structure) noexcept;
 
-/// The controller measures the load velocity (C7.17): hinf-load.
+/// The controller measures the load velocity (C7.17): hinf-load, lqg-load.
 [[nodiscard]] bool measures_load(Structure structure) noexcept;
 
-/// "pi", "pid", "pi+p", "lqg", "lqg+p", "hinf", "lqg-pos", "hinf-pos", "hinf-load".
+/// The controller measures both velocities (inputs [ω*, ωm, ωl]): lqg-load.
+[[nodiscard]] bool measures_both(Structure structure) noexcept;
+
+/// An LQG structure: lqg, lqg+p, lqg-pos, lqg-load.
+[[nodiscard]] bool is_lqg(Structure structure) noexcept;
+
+/// "pi", "pid", "pi+p", "lqg", "lqg+p", "hinf", "lqg-pos", "hinf-pos", "hinf-load", "lqg-load".
 [[nodiscard]] std::string to_string(Structure structure);
 /// Inverse of to_string; std::nullopt for an unknown name.
 [[nodiscard]] std::optional<Structure> structure_from_string(const std::string& name);
@@ -116,7 +124,8 @@ struct FullOrderSummary {
   /// smallest keeping the load position free of overshoot (‖φl/φ*‖∞ <= 1). Its state is the
   /// compensator's first.
   double prefilter_tau = 0.0;
-  /// normalized: inputs [ω*, ωm] (lqg-pos, hinf-pos: [φ*, φm]), output u (time by ωz, torque by
+  /// normalized: inputs [ω*, ωm] (lqg-pos, hinf-pos: [φ*, φm]; hinf-load [ω*, ωl]; lqg-load
+  /// [ω*, ωm, ωl]), output u (time by ωz, torque by
   /// Im ωz, positions by 1/ωz)
   core::StateSpace compensator;
   std::vector<std::complex<double>> controller_poles;  ///< normalized
@@ -173,12 +182,13 @@ struct Controller {
 [[nodiscard]] ControllerTf normalized_controller(const Controller& controller);
 
 /// A full-order `structure`'s normalized compensator as the transfer functions a VelocityLoop
-/// takes: its two_dof_form(), in velocity_form() for a position controller.
+/// takes: its two_dof_form(), in velocity_form() for a position controller. std::invalid_argument
+/// for a structure measuring both velocities (three inputs: compensator_loop builds its loop).
 [[nodiscard]] ControllerTf compensator_form(Structure structure, const core::StateSpace& compensator);
 
 /// The loop of a full-order `structure`'s normalized compensator on `plant`: compensator_form()
 /// around the motor, or around the load for a load-measuring structure (VelocityLoop::load_feedback
-/// on the first mode). `with_hf` and `with_higher_modes` as in VelocityLoop.
+/// on the first mode), or two_measurement_form() around both (VelocityLoop::two_measurements). `with_hf` and `with_higher_modes` as in VelocityLoop.
 [[nodiscard]] VelocityLoop compensator_loop(const NormalizedPlant& plant, Structure structure,
                                            const core::StateSpace& compensator, bool with_hf = true,
                                            bool with_higher_modes = true);

@@ -112,6 +112,8 @@ struct RobustnessResult {
 /// C7.13's sufficient robust performance test of a 2-DoF loop's tracking (the LQG compensators):
 /// with the plant Pm(1 + Δ W2), |Δ| <= 1, the motor tracking ωm/ω* = F T becomes F T (1 + Δ W2)/(1 + Δ W2 T),
 /// so sup_ω |F T| (1 + |W2|)/(1 − |W2 T|) / mt < 1 guarantees ‖ωm/ω*‖∞ < mt for every plant of the set.
+/// A loop measuring the load (C7.17) controls the load: the same holds for ωl/ω* (the uncertainty
+/// multiplies the torque, which reaches either velocity through the same plant), and it is judged.
 struct RobustTracking {
   double value = 0.0;  ///< the sup above (+inf when ‖W2 T‖∞ >= 1 or the loop is unstable)
   double omega = 0.0;  ///< where attained (normalized)
