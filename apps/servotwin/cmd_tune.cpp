@@ -222,18 +222,27 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
   for (const std::string& n : c.notes) fmt::print("note: {}\n", n);
 }
 
+/// The simulated variable the numbers judge, and why when it is the motor's although a load
+/// prediction was printed above.
+std::string judged_variable(const vcnc::DriveSimulation& sim) {
+  const vcnc::ControlledVariable v = vcnc::controlled_variable(sim);
+  return fmt::format("{} {}{}", v.load ? "load" : "motor", v.position ? "position" : "velocity",
+                     sim.load_side ? "" : " (this plant has no load side to simulate)");
+}
+
 void print_verification(const vcnc::DriveSimulation& sim) {
   const vcnc::DriveMetrics& m = sim.metrics;
   const vcnc::DriveMetrics& l = sim.linear_metrics;
   if (sim.test == vcnc::DriveTest::kSetpointStep) {
-    fmt::print("  step of {:g}: overshoot {:.1f} % (linear {:.1f} %), settling {} (linear {}), final error {:.3g}\n",
+    fmt::print("  step of {:g}: overshoot {:.1f} % (linear {:.1f} %), settling {} (linear {}), final error {:.3g}; "
+               "of the {}\n",
                sim.amplitude, 100.0 * m.overshoot, 100.0 * l.overshoot, time_or_never(m.settling_time), time_or_never(l.settling_time),
-               m.final_error);
+               m.final_error, judged_variable(sim));
   } else {
     fmt::print("  load step of {:.4g}: peak deviation {:.4g} (linear {:.4g}), recovery {} (linear {}), final deviation "
-               "{:.3g} (linear {:.3g})\n",
+               "{:.3g} (linear {:.3g}); of the {}\n",
                sim.amplitude, m.peak_deviation, l.peak_deviation, time_or_never(m.recovery_time), time_or_never(l.recovery_time),
-               0.0 - m.final_error, 0.0 - l.final_error);
+               0.0 - m.final_error, 0.0 - l.final_error, judged_variable(sim));
   }
   for (const std::string& n : sim.notes) fmt::print("  note: {}\n", n);
 }

@@ -135,6 +135,8 @@ TEST_F(Cli, CompareOnTheTestBedEstimatesTheLoadSide) {
   ASSERT_EQ(t.status, 0) << t.err;
   EXPECT_NE(t.out.find("note: the load side is an estimate"), std::string::npos) << t.out;
   EXPECT_NE(t.out.find("step of 1: overshoot"), std::string::npos) << t.out;
+  // The simulated step judges the motor (a transfer-function plant), the prediction the load: said.
+  EXPECT_NE(t.out.find("of the motor velocity (this plant has no load side to simulate)"), std::string::npos) << t.out;
   EXPECT_NE(t.out.find("load step: not simulated (a transfer-function plant has no load-torque input)"),
             std::string::npos) << t.out;
   // Configuration 1 has a second mode: a load side only when it is declared part of the chain.
