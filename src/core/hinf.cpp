@@ -216,11 +216,9 @@ HinfController denormalize(HinfController k, const Normalized& s) {
 /// ||F_l(P, K)||_inf < gamma (1 + 1e-6); the slack covers the rounding of a controller built
 /// from a nearly singular I - Y X / gamma^2 or a large X (measured: 1e-7 above gamma at
 /// 1.0001 gamma_opt on the C7.14 plants, where SLICOT's controller meets gamma).
-bool achieves(const StateSpace& plant, Index ny, Index nu, const HinfController& k, double* norm = nullptr) {
+bool achieves(const StateSpace& plant, Index ny, Index nu, const HinfController& k) {
   try {
-    const double value = hinf_norm(lft_lower(plant, k.controller, ny, nu), 1e-9).value;
-    if (norm != nullptr) *norm = value;
-    return value < k.gamma * (1.0 + kGammaSlack);
+    return hinf_norm_below(lft_lower(plant, k.controller, ny, nu), k.gamma * (1.0 + kGammaSlack));
   } catch (const std::invalid_argument&) {
     return false;  // unstable closed loop (or an algebraic loop)
   }
@@ -259,7 +257,7 @@ HinfSynthesis hinf_synthesis(const StateSpace& plant, Eigen::Index measurements,
     auto k = central_normalized(s, gamma);
     if (!k) return std::nullopt;
     HinfController d = denormalize(std::move(*k), s);
-    if (!achieves(plant, measurements, controls, d, &out.closed_loop_norm)) return std::nullopt;
+    if (!achieves(plant, measurements, controls, d)) return std::nullopt;
     return d;
   };
 
@@ -324,6 +322,7 @@ HinfSynthesis hinf_synthesis(const StateSpace& plant, Eigen::Index measurements,
     double unused = 0.0;
     out.design = first_verified(gamma_optimal * options.backoff, unused).second;
   }
+  out.closed_loop_norm = hinf_norm(lft_lower(plant, out.design.controller, measurements, controls), 1e-9).value;
   return out;
 }
 

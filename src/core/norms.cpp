@@ -98,6 +98,24 @@ std::vector<double> imaginary_axis_crossings(const StateSpace& s, double gamma) 
 
 }  // namespace
 
+namespace {
+
+/// The poles of s, each with Re < -100 eps ||A||; std::invalid_argument naming `who` otherwise
+/// (the H-infinity norm of an unstable system is infinite).
+Eigen::VectorXcd stable_poles(const StateSpace& s, const std::string& who) {
+  const Eigen::EigenSolver<Eigen::MatrixXd> solver(s.A, /*computeEigenvectors=*/false);
+  if (solver.info() != Eigen::Success) throw std::runtime_error(who + ": eigenvalue iteration did not converge");
+  const Eigen::VectorXcd poles = solver.eigenvalues();
+  const double stability_margin = 100.0 * kEps * s.A.norm();
+  for (Eigen::Index i = 0; i < poles.size(); ++i)
+    if (!(poles(i).real() < -stability_margin))
+      throw std::invalid_argument(who + ": the system is not stable (a pole with Re >= -100 eps ||A||); the H-infinity "
+                                        "norm is infinite");
+  return poles;
+}
+
+}  // namespace
+
 PeakResult hinf_norm(const StateSpace& sys, double rel_tol) {
   require_tolerance(rel_tol, "hinf_norm");
   FrequencyResponseEvaluator check(sys);  // validates shapes and finiteness
@@ -106,13 +124,7 @@ PeakResult hinf_norm(const StateSpace& sys, double rel_tol) {
   const Eigen::Index n = s.states();
   if (n == 0 || s.B.norm() == 0.0 || s.C.norm() == 0.0) return {sigma_d, 0.0};  // G = D at every frequency
 
-  const Eigen::EigenSolver<Eigen::MatrixXd> poles_solver(s.A, /*computeEigenvectors=*/false);
-  if (poles_solver.info() != Eigen::Success) throw std::runtime_error("hinf_norm: eigenvalue iteration did not converge");
-  const Eigen::VectorXcd poles = poles_solver.eigenvalues();
-  const double stability_margin = 100.0 * kEps * s.A.norm();
-  for (Eigen::Index i = 0; i < n; ++i)
-    if (!(poles(i).real() < -stability_margin))
-      throw std::invalid_argument("hinf_norm: the system is not stable (a pole with Re >= -100 eps ||A||); the H-infinity norm is infinite");
+  const Eigen::VectorXcd poles = stable_poles(s, "hinf_norm");
 
   FrequencyResponseEvaluator evaluator(s);
   Eigen::MatrixXcd g;
@@ -166,6 +178,33 @@ PeakResult hinf_norm(const StateSpace& sys, double rel_tol) {
     if (!(midpoints.value > gamma)) return {best.value, best.omega};
   }
   throw std::runtime_error("hinf_norm: the Bruinsma-Steinbuch iteration did not converge");
+}
+
+bool hinf_norm_below(const StateSpace& sys, double gamma) {
+  if (!std::isfinite(gamma) || !(gamma > 0.0)) throw std::invalid_argument("hinf_norm_below: gamma must be finite and > 0");
+  FrequencyResponseEvaluator check(sys);  // validates shapes and finiteness
+  if (!(sigma_max(sys.D) < gamma)) return false;
+  const StateSpace s = scaled_for_norm(sys);
+  const Eigen::Index n = s.states();
+  if (n == 0 || s.B.norm() == 0.0 || s.C.norm() == 0.0) return true;  // G = D at every frequency
+  const Eigen::VectorXcd poles = stable_poles(s, "hinf_norm_below");
+  FrequencyResponseEvaluator evaluator(s);
+  Eigen::MatrixXcd g;
+  const auto gain_at = [&](double omega) {
+    evaluator.evaluate(Complex(0.0, omega), g);
+    return sigma_max(g);
+  };
+  if (!(gain_at(0.0) < gamma)) return false;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!(gain_at(std::abs(poles(i))) < gamma)) return false;
+    if (poles(i).imag() > 0.0 && !(gain_at(poles(i).imag()) < gamma)) return false;
+  }
+  double previous = 0.0;
+  for (const double crossing : imaginary_axis_crossings(s, gamma)) {
+    if (crossing > previous && !(gain_at(0.5 * (previous + crossing)) < gamma)) return false;
+    previous = crossing;
+  }
+  return true;
 }
 
 namespace {

@@ -266,7 +266,8 @@ void refine_boundary(double lo, double hi, Evaluate&& evaluate, TuneResult::Cand
 }
 
 template <class Evaluate>
-TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Evaluate&& evaluate) {
+TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Evaluate&& evaluate,
+                             int boundary_steps = 12) {
   std::size_t best = scan.size();
   for (std::size_t i = 0; i < scan.size(); ++i) {
     if (scan[i].feasible && (best == scan.size() || scan[i].bandwidth > scan[best].bandwidth)) best = i;
@@ -274,7 +275,7 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Eva
   if (best == scan.size()) return {};
   TuneResult::Candidate chosen = scan[best];
   if (best + 1 < scan.size() && !scan[best + 1].feasible)
-    refine_boundary(scan[best].omega_star, scan[best + 1].omega_star, evaluate, chosen);
+    refine_boundary(scan[best].omega_star, scan[best + 1].omega_star, evaluate, chosen, boundary_steps);
   return chosen;
 }
 
@@ -755,12 +756,16 @@ bool closer_to_spec(const TuneResult::Candidate& a, const TuneResult::Candidate&
   return a.min_damping > b.min_damping;
 }
 
-HinfCandidate evaluate_hinf(const HinfDesigner& h, const SpecCheck& check, double omega_0s) {
+/// One w0S with the w0T ladder r, 2r, 4r, 8r from `start_omega_0t` up (C7.14's loop raises w0T on
+/// failure and keeps it when w0S is raised: a faster pair never gets a lower cap than a slower one
+/// needed). The given --omega-0t alone when set.
+HinfCandidate evaluate_hinf(const HinfDesigner& h, const SpecCheck& check, double omega_0s, double start_omega_0t) {
   const double r = h.design_plant.r;
   HinfCandidate out;
   std::optional<HinfCandidate> closest;
   for (int step = 0; step < (h.options.omega_0t ? 1 : kOmega0tSteps); ++step) {
     out.omega_0t = h.options.omega_0t.value_or(r * std::ldexp(1.0, step));
+    if (!h.options.omega_0t && step + 1 < kOmega0tSteps && out.omega_0t < start_omega_0t * (1.0 - 1e-9)) continue;
     try {
       out.candidate = check(omega_0s, h.loop(h.design(omega_0s, out.omega_0t)));
     } catch (const std::domain_error&) {
@@ -775,6 +780,21 @@ HinfCandidate evaluate_hinf(const HinfDesigner& h, const SpecCheck& check, doubl
     if (!closest || closer_to_spec(out.candidate, closest->candidate, h.options)) closest = out;
   }
   return closest.value_or(out);
+}
+
+/// Where the w0T ladder starts for `omega_0s` (C7.14's loop keeps w0T when w0S is raised): one
+/// rung below the w0T of the nearest slower design that met the spec (`met`: w0S -> w0T), since a
+/// faster pair can pass a lower cap again (C7.16's active design does); at that w0T itself between
+/// it and a faster w0S that no rung rescued (`evaluated`), where the lower rungs failed on both
+/// sides (the boundary bisections). r when no slower design met the spec.
+double ladder_start(const std::map<double, double>& met, const std::map<double, TuneResult::Candidate>& evaluated,
+                    double omega_0s) {
+  const auto slower = met.lower_bound(omega_0s);
+  if (slower == met.begin()) return 0.0;
+  const double carried = std::prev(slower)->second;
+  const auto faster = evaluated.upper_bound(omega_0s);
+  const bool bracketed = faster != evaluated.end() && !faster->second.feasible;
+  return bracketed ? carried : 0.5 * carried;
 }
 
 /// What the design did with the higher modes (C7.16).
@@ -817,17 +837,25 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
   s.modes = plant.higher_modes.empty() ? ModeHandling::kFirstMode : options.hinf_modes;
   if (options.rolloff_rad_s) s.rolloff = *options.rolloff_rad_s / plant.omega_z;
   std::map<double, double> ladder;  // w0S -> the w0T its evaluation chose
+  std::map<double, double> met_at;  // the same for the w0S that met the spec
   if (options.omega_0s) {
     s.omega_0s = *options.omega_0s;
     s.omega_0s_source = "given";
   } else {
+    std::map<double, TuneResult::Candidate> evaluated;  // the boundary bisections revisit w0S
     const auto evaluate = [&](double w) {
-      const HinfCandidate c = evaluate_hinf(h, check, w);
+      if (const auto seen = evaluated.find(w); seen != evaluated.end()) return seen->second;
+      const double start = ladder_start(met_at, evaluated, w);
+      const HinfCandidate c = evaluate_hinf(h, check, w, start);
       ladder[w] = c.omega_0t;
+      if (c.candidate.feasible) met_at[w] = c.omega_0t;
+      evaluated[w] = c.candidate;
       return c.candidate;
     };
-    // C7.14's loop: raise w0S while some w0T meets the spec; stop after two w0S in a row that no
-    // w0T of the ladder rescues (a faster pair only raises the peaks further).
+    // C7.14's loop: raise w0S while some w0T meets the spec (w0T kept from the last success, raised
+    // on failure); stop after two w0S in a row that no w0T of the ladder rescues (a faster pair
+    // only raises the peaks further). Keeping w0T saves the ladder's lower rungs, which a faster
+    // pair rarely passes again: 4-6x fewer syntheses than restarting each w0S at r.
     bool met = false;
     int misses = 0;
     const double fastest = kOmega0sFastestPerR * plant.r;
@@ -838,14 +866,15 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
       // Load feedback (C7.17) has no such monotony: a band of low w0S can fail between feasible ones.
       if (met && misses == 2 && !measures_load(options.structure)) break;
     }
-    TuneResult::Candidate chosen = choose(result.scan, evaluate);
+    constexpr int kBoundarySteps = 8;  // scan points 1.3 apart: 0.1 % in w0S
+    TuneResult::Candidate chosen = choose(result.scan, evaluate, kBoundarySteps);
     if (!chosen.feasible) no_feasible_omega(result.scan, options);
     // The w0T ladder makes the bandwidth jump along w0S: the upper end of the feasible range may
-    // beat the best scanned point even when its neighbour is feasible.
+    // beat the best scanned point even when its neighbour is feasible (when it is the best, this
+    // bisection repeats the one above: `evaluated` answers it).
     std::size_t last = 0;
     for (std::size_t i = 0; i < result.scan.size(); ++i)
       if (result.scan[i].feasible) last = i;
-    constexpr int kBoundarySteps = 8;  // scan points 1.3 apart: 0.1 % in w0S
     if (last + 1 < result.scan.size())
       refine_boundary(result.scan[last].omega_star, result.scan[last + 1].omega_star, evaluate, chosen, kBoundarySteps);
     s.omega_0s = chosen.omega_star;
@@ -863,7 +892,7 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
     s.omega_0t = *options.omega_0t;
   } else {
     const auto found = ladder.find(s.omega_0s);
-    s.omega_0t = found != ladder.end() ? found->second : evaluate_hinf(h, check, s.omega_0s).omega_0t;
+    s.omega_0t = found != ladder.end() ? found->second : evaluate_hinf(h, check, s.omega_0s, 0.0).omega_0t;
   }
   HinfDesign d;
   try {

@@ -71,6 +71,49 @@ TEST(HinfNorm, MatchesDenseGridReference) {
   }
 }
 
+TEST(HinfNormBelow, DecidesTheGridReferenceNormAndTheClosedForm) {
+  // The bounded-real test must agree with the grid-refined norms of the reference (scipy) just
+  // above and just below them, and with the resonance peak's closed form, including peaks far
+  // from any pole frequency's probe (lightly damped pairs) and a peak at infinity.
+  for (const auto& c : control_reference().at("hinf")) {
+    const std::string name = c.at("system");
+    SCOPED_TRACE(name);
+    const StateSpace sys = reference_system(name);
+    const double norm = c.at("value").get<double>();
+    EXPECT_TRUE(hinf_norm_below(sys, norm * (1.0 + 1e-5)));
+    EXPECT_FALSE(hinf_norm_below(sys, norm * (1.0 - 1e-5)));
+  }
+  for (const double zeta : {0.001, 0.05, 0.6}) {
+    const StateSpace sys = second_order(866.0, zeta);
+    EXPECT_TRUE(hinf_norm_below(sys, resonance_peak(zeta) * (1.0 + 1e-8))) << zeta;
+    EXPECT_FALSE(hinf_norm_below(sys, resonance_peak(zeta) * (1.0 - 1e-8))) << zeta;
+  }
+  // Random stable systems against hinf_norm itself (1e-9).
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 30; ++trial) {
+    StateSpace sys;
+    const Eigen::Index n = 2 + trial % 5;
+    sys.A = Eigen::MatrixXd::NullaryExpr(n, n, [&] { return normal(rng); });
+    const double shift = sys.A.eigenvalues().real().maxCoeff() + 0.1 + 0.5 * std::abs(normal(rng));
+    sys.A -= shift * Eigen::MatrixXd::Identity(n, n);
+    sys.B = Eigen::MatrixXd::NullaryExpr(n, 2, [&] { return normal(rng); });
+    sys.C = Eigen::MatrixXd::NullaryExpr(2, n, [&] { return normal(rng); });
+    sys.D = 0.1 * Eigen::MatrixXd::NullaryExpr(2, 2, [&] { return normal(rng); });
+    const double norm = hinf_norm(sys, 1e-9).value;
+    EXPECT_TRUE(hinf_norm_below(sys, norm * (1.0 + 1e-6))) << trial;
+    EXPECT_FALSE(hinf_norm_below(sys, norm * (1.0 - 1e-6))) << trial;
+  }
+  // Below sigma_max(D) it cannot be; an unstable system and a gamma <= 0 are errors.
+  StateSpace feedthrough = second_order(1.0, 0.5);
+  feedthrough.D(0, 0) = 2.0;
+  EXPECT_FALSE(hinf_norm_below(feedthrough, 1.99));
+  StateSpace unstable = second_order(1.0, 0.5);
+  unstable.A = -unstable.A;
+  EXPECT_THROW((void)hinf_norm_below(unstable, 10.0), std::invalid_argument);
+  EXPECT_THROW((void)hinf_norm_below(second_order(1.0, 0.5), 0.0), std::invalid_argument);
+}
+
 TEST(HinfNorm, SecondOrderResonanceClosedForm) {
   for (const double wn : {1e-2, 1.0, 866.0, 1e4}) {
     for (const double zeta : {0.001, 0.01, 0.05, 0.3, 0.6}) {

@@ -52,6 +52,15 @@ struct PeakResult {
 /// the state units.
 PeakResult hinf_norm(const StateSpace& sys, double rel_tol = 1e-6);
 
+/// ||G||_inf < gamma for a stable sys, decided with one Hamiltonian eigenvalue problem (the bounded
+/// real lemma: with sigma_max(D) < gamma the norm reaches gamma only where M of hinf_norm has an
+/// imaginary eigenvalue) instead of hinf_norm's iteration: what a gamma-iteration asks of each
+/// candidate. Gains at DC and the poles' frequencies are tried first (a cheap "no"); eigenvalues
+/// counted as imaginary by hinf_norm's loose test are confirmed by the gain between them, so a
+/// rounding artefact does not reject a system below gamma. std::invalid_argument for gamma not
+/// finite and > 0, for shapes as hinf_norm, and for an unstable system (as hinf_norm).
+bool hinf_norm_below(const StateSpace& sys, double gamma);
+
 /// Supremum of |f(omega)| over [grid.front(), grid.back()]: |f| on every grid point, then each
 /// local maximum of the grid values (a point above its left and not below its right neighbour;
 /// the end points count) is refined by golden-section search in log omega over the bracket of its
