@@ -188,6 +188,56 @@ TEST(Lqg, IntegralActionGivesUnitStaticGainsAndRejectsLoadTorque) {
   EXPECT_NEAR(static_output(p, pp, 1, 0.0, 0.4), -0.4 / plant.stiffness, 1e-9);
 }
 
+const nlohmann::json& octave_reference() {
+  static const nlohmann::json j =
+      test_support::read_json_fixture("tuning/lqg_octave_reference.json", "lqg_octave_reference.m");
+  return j;
+}
+
+/// K and L of `d` against Octave's lqr and lqe for case `c` (L as rows of measurements' columns).
+void expect_octave_gains(const LqgDesign& d, const nlohmann::json& c) {
+  const auto& k = c.at("K");
+  ASSERT_EQ(static_cast<std::size_t>(d.regulator_gain.size()), k.size());
+  for (Eigen::Index i = 0; i < d.regulator_gain.size(); ++i) {
+    const double want = k.at(static_cast<std::size_t>(i));
+    EXPECT_NEAR(d.regulator_gain(i), want, 1e-8 * std::max(1.0, std::abs(want))) << "K " << i;
+  }
+  const auto& l = c.at("L");
+  ASSERT_EQ(static_cast<std::size_t>(d.estimator_gain.rows()), l.size());
+  for (Eigen::Index i = 0; i < d.estimator_gain.rows(); ++i) {
+    ASSERT_EQ(static_cast<std::size_t>(d.estimator_gain.cols()), l.at(static_cast<std::size_t>(i)).size());
+    for (Eigen::Index j = 0; j < d.estimator_gain.cols(); ++j) {
+      const double want = l.at(static_cast<std::size_t>(i)).at(static_cast<std::size_t>(j));
+      EXPECT_NEAR(d.estimator_gain(i, j), want, 1e-8 * std::max(1.0, std::abs(want))) << "L " << i << "," << j;
+    }
+  }
+  expect_same_roots(d.regulator_poles, roots_of(c.at("lqr_poles")), 1e-8, "lqr poles");
+  expect_same_roots(d.estimator_poles, roots_of(c.at("kf_poles")), 1e-8, "lqe poles");
+}
+
+TEST(Lqg, GainsEqualOctavesLqrAndLqe) {
+  // The side-by-side with GNU Octave (control 3.4: lqr and lqe, SLICOT's Riccati solvers)
+  // for the velocity (E29, C7.13's kbw sweep, viscous frictions), load-side (C7.17) and position
+  // LQGs; tools/reference/lqg_octave_reference.m writes the models out from the equations of
+  // motion. Our Riccati solver (matrix sign + Newton-Kleinman on Eigen) must give the same gains.
+  for (const char* kind : {"velocity", "load_side", "position"}) {
+    for (const auto& c : octave_reference().at(kind)) {
+      const double r = c.at("r");
+      const FrictionTwoMass plant = normalized(r, c.at("zeta_z"), c.at("bm"), c.at("bl"));
+      SCOPED_TRACE(std::string(kind) + " r = " + std::to_string(r) + " kbw = " + std::to_string(c.at("kbw").get<double>()));
+      if (std::string(kind) == "position") {
+        PositionLqgOptions o;
+        o.kbw = c.at("kbw");
+        expect_octave_gains(position_lqg(plant, r, o), c);
+      } else {
+        VelocityLqgOptions o;
+        o.kbw = c.at("kbw");
+        expect_octave_gains(std::string(kind) == "velocity" ? velocity_lqg(plant, r, o) : load_side_lqg(plant, r, o), c);
+      }
+    }
+  }
+}
+
 TEST(Lqg, PositionDesignsMatchScipy) {
   for (const auto& c : lqg_reference().at("position")) {
     const double r = c.at("r");
