@@ -114,6 +114,29 @@ Eigen::VectorXcd stable_poles(const StateSpace& s, const std::string& who) {
   return poles;
 }
 
+/// Where a peak search starts: DC, and each pole's natural and (above the real axis) damped
+/// frequency, in that order.
+std::vector<double> pole_frequencies(const Eigen::VectorXcd& poles) {
+  std::vector<double> omegas{0.0};
+  for (const Complex& p : poles) {
+    omegas.push_back(std::abs(p));
+    if (p.imag() > 0.0) omegas.push_back(p.imag());
+  }
+  return omegas;
+}
+
+/// The midpoint of each interval between consecutive imaginary-axis crossings, the first interval
+/// starting at 0: where sigma_max can exceed the gamma the crossings belong to.
+std::vector<double> crossing_midpoints(const std::vector<double>& crossings) {
+  std::vector<double> midpoints;
+  double previous = 0.0;
+  for (const double crossing : crossings) {
+    if (crossing > previous) midpoints.push_back(0.5 * (previous + crossing));
+    previous = crossing;
+  }
+  return midpoints;
+}
+
 }  // namespace
 
 PeakResult hinf_norm(const StateSpace& sys, double rel_tol) {
@@ -135,20 +158,12 @@ PeakResult hinf_norm(const StateSpace& sys, double rel_tol) {
 
   // Lower bound: DC, every pole's natural and damped frequency, and the limit at infinity.
   BestGain best;
-  best.offer(gain_at(0.0), 0.0);
-  double smallest_pole = kInf, largest_pole = 0.0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double magnitude = std::abs(poles(i));
-    smallest_pole = std::min(smallest_pole, magnitude);
-    largest_pole = std::max(largest_pole, magnitude);
-    best.offer(gain_at(magnitude), magnitude);
-    if (poles(i).imag() > 0.0) best.offer(gain_at(poles(i).imag()), poles(i).imag());
-  }
+  for (const double omega : pole_frequencies(poles)) best.offer(gain_at(omega), omega);
   best.offer(sigma_d, kInf);
   if (best.value == 0.0) {
     // Every entry of G is N_ij(s)/det(sI - A) with deg N_ij < n (D = 0 here). Zero at s = 0 and at
     // +-j omega_k for n/2 + 1 further distinct omega_k means more than n - 1 roots: N_ij = 0.
-    const double lo = 0.5 * smallest_pole, hi = 2.0 * largest_pole;
+    const double lo = 0.5 * poles.cwiseAbs().minCoeff(), hi = 2.0 * poles.cwiseAbs().maxCoeff();
     const Eigen::Index count = n / 2 + 2;
     for (Eigen::Index k = 0; k < count; ++k) {
       const double omega = lo * std::pow(hi / lo, static_cast<double>(k + 1) / static_cast<double>(count + 1));
@@ -164,14 +179,7 @@ PeakResult hinf_norm(const StateSpace& sys, double rel_tol) {
     // sigma_max > gamma only between crossings; 0 bounds the first interval (sigma_max(G(0)) and
     // sigma_max(D) are <= the lower bound < gamma, so a crossing lost to rounding costs nothing).
     BestGain midpoints;
-    double previous = 0.0;
-    for (const double crossing : crossings) {
-      if (crossing > previous) {
-        const double mid = 0.5 * (previous + crossing);
-        midpoints.offer(gain_at(mid), mid);
-      }
-      previous = crossing;
-    }
+    for (const double mid : crossing_midpoints(crossings)) midpoints.offer(gain_at(mid), mid);
     best.offer(midpoints.value, midpoints.omega);
     // No midpoint above gamma: the crossings were rounding artefacts of eigenvalues near the axis,
     // and the evaluated gains confirm gamma as an upper bound.
@@ -194,17 +202,11 @@ bool hinf_norm_below(const StateSpace& sys, double gamma) {
     evaluator.evaluate(Complex(0.0, omega), g);
     return sigma_max(g);
   };
-  if (!(gain_at(0.0) < gamma)) return false;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (!(gain_at(std::abs(poles(i))) < gamma)) return false;
-    if (poles(i).imag() > 0.0 && !(gain_at(poles(i).imag()) < gamma)) return false;
-  }
-  double previous = 0.0;
-  for (const double crossing : imaginary_axis_crossings(s, gamma)) {
-    if (crossing > previous && !(gain_at(0.5 * (previous + crossing)) < gamma)) return false;
-    previous = crossing;
-  }
-  return true;
+  const auto below = [&](double omega) { return gain_at(omega) < gamma; };
+  const std::vector<double> probes = pole_frequencies(poles);
+  if (!std::all_of(probes.begin(), probes.end(), below)) return false;
+  const std::vector<double> midpoints = crossing_midpoints(imaginary_axis_crossings(s, gamma));
+  return std::all_of(midpoints.begin(), midpoints.end(), below);
 }
 
 namespace {

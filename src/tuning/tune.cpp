@@ -4,6 +4,7 @@
 #include <cmath>
 #include <complex>
 #include <functional>
+#include <iterator>
 #include <fmt/format.h>
 #include <limits>
 #include <map>
@@ -783,18 +784,19 @@ HinfCandidate evaluate_hinf(const HinfDesigner& h, const SpecCheck& check, doubl
 }
 
 /// Where the w0T ladder starts for `omega_0s` (C7.14's loop keeps w0T when w0S is raised): one
-/// rung below the w0T of the nearest slower design that met the spec (`met`: w0S -> w0T), since a
-/// faster pair can pass a lower cap again (C7.16's active design does); at that w0T itself between
-/// it and a faster w0S that no rung rescued (`evaluated`), where the lower rungs failed on both
-/// sides (the boundary bisections). r when no slower design met the spec.
-double ladder_start(const std::map<double, double>& met, const std::map<double, TuneResult::Candidate>& evaluated,
-                    double omega_0s) {
-  const auto slower = met.lower_bound(omega_0s);
-  if (slower == met.begin()) return 0.0;
-  const double carried = std::prev(slower)->second;
+/// rung below the w0T of the nearest slower design that met the spec, since a faster pair can pass
+/// a lower cap again (C7.16's active design does); at that w0T itself between it and a faster w0S
+/// that no rung rescued, where the lower rungs failed on both sides (the boundary bisections). r
+/// when no slower design met the spec. `evaluated`: every w0S designed so far.
+double ladder_start(const std::map<double, HinfCandidate>& evaluated, double omega_0s) {
   const auto faster = evaluated.upper_bound(omega_0s);
-  const bool bracketed = faster != evaluated.end() && !faster->second.feasible;
-  return bracketed ? carried : 0.5 * carried;
+  for (auto slower = std::make_reverse_iterator(faster); slower != evaluated.rend(); ++slower) {
+    if (!slower->second.candidate.feasible) continue;
+    const double carried = slower->second.omega_0t;
+    const bool bracketed = faster != evaluated.end() && !faster->second.candidate.feasible;
+    return bracketed ? carried : 0.5 * carried;
+  }
+  return 0.0;
 }
 
 /// What the design did with the higher modes (C7.16).
@@ -836,21 +838,15 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
   s.xi_v = options.xi_v;
   s.modes = plant.higher_modes.empty() ? ModeHandling::kFirstMode : options.hinf_modes;
   if (options.rolloff_rad_s) s.rolloff = *options.rolloff_rad_s / plant.omega_z;
-  std::map<double, double> ladder;  // w0S -> the w0T its evaluation chose
-  std::map<double, double> met_at;  // the same for the w0S that met the spec
+  std::map<double, HinfCandidate> evaluated;  // w0S -> its design's spec and w0T
   if (options.omega_0s) {
     s.omega_0s = *options.omega_0s;
     s.omega_0s_source = "given";
   } else {
-    std::map<double, TuneResult::Candidate> evaluated;  // the boundary bisections revisit w0S
     const auto evaluate = [&](double w) {
-      if (const auto seen = evaluated.find(w); seen != evaluated.end()) return seen->second;
-      const double start = ladder_start(met_at, evaluated, w);
-      const HinfCandidate c = evaluate_hinf(h, check, w, start);
-      ladder[w] = c.omega_0t;
-      if (c.candidate.feasible) met_at[w] = c.omega_0t;
-      evaluated[w] = c.candidate;
-      return c.candidate;
+      // The boundary bisections revisit w0S: each is designed once.
+      if (const auto seen = evaluated.find(w); seen != evaluated.end()) return seen->second.candidate;
+      return evaluated.emplace(w, evaluate_hinf(h, check, w, ladder_start(evaluated, w))).first->second.candidate;
     };
     // C7.14's loop: raise w0S while some w0T meets the spec (w0T kept from the last success, raised
     // on failure); stop after two w0S in a row that no w0T of the ladder rescues (a faster pair
@@ -891,8 +887,8 @@ void tune_hinf(TuneResult& result, const TuneOptions& options, const SpecCheck& 
   if (options.omega_0t) {
     s.omega_0t = *options.omega_0t;
   } else {
-    const auto found = ladder.find(s.omega_0s);
-    s.omega_0t = found != ladder.end() ? found->second : evaluate_hinf(h, check, s.omega_0s, 0.0).omega_0t;
+    const auto found = evaluated.find(s.omega_0s);
+    s.omega_0t = found != evaluated.end() ? found->second.omega_0t : evaluate_hinf(h, check, s.omega_0s, 0.0).omega_0t;
   }
   HinfDesign d;
   try {

@@ -168,6 +168,17 @@ TEST(TunePosition, HinfPosIsTheC714PositionDesignWithItsPrefilterWithinTheSpec) 
   EXPECT_LE(c.predicted.peak_tl, 1.0 + 1e-6);
 }
 
+/// A load-measuring structure is refused on `model` with a second mode (no two-mass load to
+/// measure: the error names --structure and says `message`) and by the motor-feedback comparison.
+void expect_refused_without_a_two_mass_load(const fit::PlantModel& model, Structure structure,
+                                            const std::string& message) {
+  fit::PlantModel two_modes = model;
+  two_modes.modes.push_back({{8.0 * 2.0 * std::numbers::pi * 40.0, 0.01}, {10.0 * 2.0 * std::numbers::pi * 40.0, 0.02}});
+  test::expect_input_error([&] { (void)tune(two_modes, position_options(structure)); }, "--structure", message);
+  test::expect_input_error([&] { (void)compare_structures(model, TuneOptions{}, {structure}); }, "structures",
+                           "measures the load");
+}
+
 TEST(TunePosition, PositionStructuresAreRefusedWhereAVelocityLoopIsExpected) {
   test::expect_input_error(
       [] { (void)compare_structures(test::two_mass_model(3.0, 0.01), TuneOptions{}, {Structure::kLqgPos}); },
@@ -215,12 +226,7 @@ TEST(TuneLoadFeedback, HinfLoadIsTheC717DesignAndItsLoopIsTheLoadMeasured) {
   EXPECT_GT(c.full_order->hinf->omega_0s, 0.5);
   EXPECT_GT(c.predicted.bandwidth_load, 2.0);
   // A plant with a higher mode has no two-mass load to measure.
-  fit::PlantModel two_modes = model;
-  two_modes.modes.push_back({{8.0 * 2.0 * std::numbers::pi * 40.0, 0.01}, {10.0 * 2.0 * std::numbers::pi * 40.0, 0.02}});
-  test::expect_input_error([&] { (void)tune(two_modes, position_options(Structure::kHinfLoad)); }, "--structure",
-                           "needs a two-mass plant");
-  test::expect_input_error(
-      [&] { (void)compare_structures(model, TuneOptions{}, {Structure::kHinfLoad}); }, "structures", "measures the load");
+  expect_refused_without_a_two_mass_load(model, Structure::kHinfLoad, "needs a two-mass plant");
 }
 
 TEST(TuneLoadFeedback, LqgLoadIsC717sLqgAndItsLoopIsBothVelocitiesMeasured) {
@@ -261,12 +267,7 @@ TEST(TuneLoadFeedback, LqgLoadIsC717sLqgAndItsLoopIsBothVelocitiesMeasured) {
   const TuneResult motor = tune(model, position_options(Structure::kLqg));
   EXPECT_GT(c.predicted.bandwidth_load, 2.0 * motor.controller.predicted.bandwidth_load);
   // Refused where there is no two-mass load to measure, and by the motor-feedback comparison.
-  fit::PlantModel two_modes = model;
-  two_modes.modes.push_back({{8.0 * 2.0 * std::numbers::pi * 40.0, 0.01}, {10.0 * 2.0 * std::numbers::pi * 40.0, 0.02}});
-  test::expect_input_error([&] { (void)tune(two_modes, position_options(Structure::kLqgLoad)); }, "--structure",
-                           "lqg-load (C7.17) needs a two-mass plant");
-  test::expect_input_error(
-      [&] { (void)compare_structures(model, TuneOptions{}, {Structure::kLqgLoad}); }, "structures", "measures the load");
+  expect_refused_without_a_two_mass_load(model, Structure::kLqgLoad, "lqg-load (C7.17) needs a two-mass plant");
   EXPECT_EQ(structure_from_string("lqg-load"), Structure::kLqgLoad);
   EXPECT_TRUE(measures_both(Structure::kLqgLoad) && measures_load(Structure::kLqgLoad) && is_lqg(Structure::kLqgLoad));
   EXPECT_FALSE(measures_both(Structure::kHinfLoad));

@@ -65,20 +65,6 @@ inline std::vector<double> model_tracking_error(const rapid::AxisModel& model, c
   return model.simulate(trace.cmd, options).tracking_error;
 }
 
-/// RMS of (predicted - actual tracking error) / RMS of the actual one, the actual error being
-/// command - `position`, the model simulated from the command and the capture's first reading.
-inline double error_ratio(const rapid::AxisModel& model, const core::AxisTrace& trace, const std::vector<double>& position,
-                          int shift) {
-  const std::vector<double> predicted = model_tracking_error(model, trace, shift);
-  double diff = 0.0, actual = 0.0;
-  for (std::size_t k = 0; k < trace.cmd.size(); ++k) {
-    const double e = trace.cmd[k] - position[k];
-    diff += (predicted[k] - e) * (predicted[k] - e);
-    actual += e * e;
-  }
-  return std::sqrt(diff / actual);
-}
-
 /// RMS of (predicted - actual tracking error) / RMS of the actual one, for positions already
 /// predicted by any means (the tracking errors are command - position).
 inline double position_error_ratio(const std::vector<double>& command, const std::vector<double>& predicted,
@@ -89,6 +75,16 @@ inline double position_error_ratio(const std::vector<double>& command, const std
     norm += (command[k] - actual[k]) * (command[k] - actual[k]);
   }
   return std::sqrt(diff / norm);
+}
+
+/// RMS of (predicted - actual tracking error) / RMS of the actual one, the actual error being
+/// command - `position`, the model simulated from the command and the capture's first reading.
+inline double error_ratio(const rapid::AxisModel& model, const core::AxisTrace& trace, const std::vector<double>& position,
+                          int shift) {
+  const std::vector<double> error = model_tracking_error(model, trace, shift);
+  std::vector<double> predicted(error.size());
+  for (std::size_t k = 0; k < error.size(); ++k) predicted[k] = trace.cmd[k] - error[k];
+  return position_error_ratio(trace.cmd, predicted, position);
 }
 
 /// |RMS(predicted tracking error) / RMS(actual tracking error) - 1|: how well the size of the

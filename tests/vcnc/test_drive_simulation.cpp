@@ -171,6 +171,13 @@ machine::PlantConfig scaled_plant() {
   return p;
 }
 
+/// The unit-step response of a normalized closed-loop function `f` of tuning result `r` at the
+/// physical plant's samples (normalized time = physical time · ωz).
+std::vector<double> step_at_plant_samples(const core::TransferFunction& f, const machine::PlantConfig& plant,
+                                          const tuning::TuneResult& r, std::size_t samples) {
+  return core::step_response(f, plant.settings.ts * r.controller.plant.omega_z, samples);
+}
+
 TEST(DriveSimulation, PositionControllersFollowTheirContinuousLoopsInPhysicalUnits) {
   // lqg-pos and hinf-pos read [φ*, φm]; de-normalized with positions scaled by ωz (to_physical),
   // Tustin at ts, they must reproduce the continuous normalized loop's load-position step (time
@@ -187,8 +194,7 @@ TEST(DriveSimulation, PositionControllersFollowTheirContinuousLoopsInPhysicalUni
     const DriveSimulation sim = simulate_drive(plant, r.controller, s);
     EXPECT_TRUE(controlled_variable(sim).position);
     const auto loop = tuning::integrated_outputs(continuous_loop(r));
-    const double dt_normalized = plant.settings.ts * r.controller.plant.omega_z;
-    const auto load = core::step_response(*loop.load_tracking, dt_normalized, sim.samples.size());
+    const auto load = step_at_plant_samples(*loop.load_tracking, plant, r, sim.samples.size());
     EXPECT_LT(max_difference(sim.samples, load, [](const DriveSample& x) { return x.load_position; }), 5e-3);
     EXPECT_NEAR(sim.samples.back().load_position, 1.0, 1e-3);
     EXPECT_NEAR(sim.metrics.overshoot, r.controller.predicted.overshoot, 5e-3);
@@ -226,8 +232,7 @@ TEST(DriveSimulation, LoadMeasuringControllerFollowsItsContinuousLoop) {
   ASSERT_FALSE(sim.notes.empty());
   EXPECT_NE(sim.notes.front().find("moved from motor_velocity to load_velocity"), std::string::npos) << sim.notes.front();
   const auto loop = tuning::controller_loop(r.plant, r.controller, false).closed_loop();
-  const double dt_normalized = plant.settings.ts * r.controller.plant.omega_z;
-  const auto load = core::step_response(*loop.load_tracking, dt_normalized, sim.samples.size());
+  const auto load = step_at_plant_samples(*loop.load_tracking, plant, r, sim.samples.size());
   EXPECT_LT(max_difference(sim.samples, load, [](const DriveSample& x) { return x.load_velocity; }), 5e-3);
   EXPECT_NEAR(sim.samples.back().load_velocity, 1.0, 1e-4);
   expect_load_torque_rejected_from_the_load(plant, r.controller, s);
@@ -243,14 +248,13 @@ TEST(DriveSimulation, ControllerMeasuringBothVelocitiesFollowsItsContinuousLoop)
   const auto loop = tuning::controller_loop(r.plant, r.controller, false).closed_loop();
   DriveSimulationSettings s;
   s.duration_s = 20.0;
-  const double dt_normalized = plant.settings.ts * r.controller.plant.omega_z;
   for (const auto output : {machine::PlantOutput::MotorVelocity, machine::PlantOutput::LoadVelocity}) {
     plant.settings.output = output;
     const DriveSimulation sim = simulate_drive(plant, r.controller, s);
     ASSERT_FALSE(sim.notes.empty());
     EXPECT_NE(sim.notes.front().find("measures both velocities"), std::string::npos) << sim.notes.front();
-    const auto load = core::step_response(*loop.load_tracking, dt_normalized, sim.samples.size());
-    const auto motor = core::step_response(loop.motor_tracking, dt_normalized, sim.samples.size());
+    const auto load = step_at_plant_samples(*loop.load_tracking, plant, r, sim.samples.size());
+    const auto motor = step_at_plant_samples(loop.motor_tracking, plant, r, sim.samples.size());
     EXPECT_LT(max_difference(sim.samples, load, [](const DriveSample& x) { return x.load_velocity; }), 5e-3);
     // The motor swings to about 19 times the step to whip the load through the shaft: 1 % of that.
     const double motor_swing = *std::max_element(motor.begin(), motor.end());
