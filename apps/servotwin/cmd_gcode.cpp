@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <tuple>
 
 #include "command.hpp"
 #include "servotwin/core/error.hpp"
@@ -14,8 +15,6 @@ namespace servotwin::cli {
 
 namespace {
 
-const std::map<std::string, motion::Dialect> kDialects{{"iso", motion::Dialect::Iso},
-                                                       {"heidenhain", motion::Dialect::Heidenhain}};
 
 struct IdentificationArgs {
   std::vector<std::string> axes{"X"};
@@ -26,6 +25,7 @@ struct IdentificationArgs {
   std::uint64_t seed = 1;
   motion::Dialect dialect = motion::Dialect::Iso;
   std::string name = "RAPIDIDENT";
+  PathModeOption path_mode;
   std::string output = "-";
   CLI::Option *moves_opt = nullptr, *range_opt = nullptr, *feed_opt = nullptr;
 };
@@ -49,6 +49,7 @@ int run_identification(const IdentificationArgs& a, const GlobalOptions& global)
   o.seed = a.seed;
   o.name = a.name;
   o.dialect = a.dialect;
+  std::tie(o.path_control, o.blend_tolerance_mm) = a.path_mode.parse(o.dialect);
   const motion::Program program = motion::make_identification_program(o);
   auto out = open_output(a.output, global);
   out->stream() << motion::write_program(program);
@@ -62,6 +63,7 @@ struct ContourArgs {
   std::string shape = "circle";
   motion::ContourProgramOptions options;
   std::vector<double> center;
+  PathModeOption path_mode;
   std::string output = "-";
 };
 
@@ -72,6 +74,7 @@ int run_contour(const ContourArgs& a, const GlobalOptions& global) {
       throw core::InputError({"", 0, 0, "--center"}, "give at most X Y Z, got " + std::to_string(a.center.size()) + " values");
     for (std::size_t i = 0; i < a.center.size(); ++i) o.center[i] = a.center[i];
   }
+  std::tie(o.path_control, o.blend_tolerance_mm) = a.path_mode.parse(o.dialect);
   const motion::Program program = a.shape == "circle" ? motion::make_circle_program(o) : motion::make_diamond_program(o);
   auto out = open_output(a.output, global);
   out->stream() << motion::write_program(program);
@@ -89,12 +92,31 @@ struct ProgramArgs {
 
 std::string plural(std::size_t n, const char* word) { return fmt::format("{} {}{}", n, word, n == 1 ? "" : "s"); }
 
+/// The modes the motion blocks run in, in order of first use, with their block counts.
+std::string path_control_summary(const motion::Program& program) {
+  std::vector<std::pair<std::string, std::size_t>> modes;
+  for (const auto& b : program.blocks) {
+    if (b.type == motion::BlockType::None || b.type == motion::BlockType::Dwell) continue;
+    const std::string text = motion::describe_path_control(b.path_control, b.blend_tolerance_mm);
+    auto it = std::find_if(modes.begin(), modes.end(), [&](const auto& m) { return m.first == text; });
+    if (it == modes.end()) {
+      modes.emplace_back(text, 1);
+    } else {
+      ++it->second;
+    }
+  }
+  if (modes.empty()) return "no motion";
+  std::string out;
+  for (const auto& [text, count] : modes) out += (out.empty() ? "" : "; ") + text + " (" + plural(count, "motion block") + ")";
+  return out;
+}
+
 int run_check(const ProgramArgs& a, const GlobalOptions& /*global*/) {
   const motion::Program program = load_program(a.program);
   std::map<motion::BlockType, std::size_t> counts;
   for (const auto& b : program.blocks) ++counts[b.type];
-  fmt::print("{}: {} program, {}: {}, {}, {}, {}\n", a.program.path,
-             program.dialect == motion::Dialect::Iso ? "ISO" : "Heidenhain", plural(program.blocks.size(), "block"),
+  fmt::print("{}: {} program, {}: {}, {}, {}, {}\n", a.program.path, dialect_title(program.dialect),
+             plural(program.blocks.size(), "block"),
              plural(counts[motion::BlockType::Rapid], "rapid move"), plural(counts[motion::BlockType::Linear], "line"),
              plural(counts[motion::BlockType::ArcCw] + counts[motion::BlockType::ArcCcw], "arc"),
              plural(counts[motion::BlockType::Dwell], "dwell"));
@@ -110,13 +132,16 @@ int run_check(const ProgramArgs& a, const GlobalOptions& /*global*/) {
   }
   fmt::print("  path length {:.3f} mm; cycle time {:.3f} s at {} mm/s^2 (trapezoidal, rapid F{}); {}\n", path_mm,
              plan.duration(), limits.accel, limits.rapid_feed_mm_min, plural(program.warnings.size(), "warning"));
+  fmt::print("  path control: {}\n", path_control_summary(program));
   return kSuccess;
 }
 
 int run_convert(const ProgramArgs& a, const GlobalOptions& global) {
   const motion::Program program = load_program(a.program);
   auto out = open_output(a.output, global);
-  out->stream() << (kDialects.at(a.to) == motion::Dialect::Iso ? motion::write_iso(program) : motion::write_heidenhain(program));
+  motion::Program converted = program;
+  converted.dialect = dialect_names().at(a.to);
+  out->stream() << motion::write_program(converted);
   out->commit();
   return kSuccess;
 }
@@ -154,9 +179,10 @@ void register_gcode(CLI::App& app, Action& selected) {
   id->feed_opt = gen->add_option("--feed", id->feed, "Programmed feed [mm/min]");
   gen->add_option("--center", id->center, "Centre of the motion range [mm], one value per axis");
   gen->add_option("--seed", id->seed, "Random seed: the same seed gives the same program")->capture_default_str();
-  gen->add_option("--dialect", id->dialect, "Output dialect: iso or heidenhain")
-      ->transform(CLI::CheckedTransformer(kDialects, CLI::ignore_case))
+  gen->add_option("--dialect", id->dialect, "Output dialect: iso, linuxcnc or heidenhain")
+      ->transform(CLI::CheckedTransformer(dialect_names(), CLI::ignore_case))
       ->capture_default_str();
+  id->path_mode.add_to(*gen);
   gen->add_option("--name", id->name, "Program name (Heidenhain BEGIN PGM)")->capture_default_str();
   gen->add_option("-o,--output", id->output, "Output file, - for standard output")->capture_default_str();
   set_examples(*gen,
@@ -175,12 +201,14 @@ void register_gcode(CLI::App& app, Action& selected) {
   con->add_option("--feed", contour->options.feed_mm_min, "Programmed feed [mm/min] (F12000 = 200 mm/s)")
       ->capture_default_str();
   con->add_option("--center", contour->center, "Centre X Y [Z] [mm] (default: the origin)");
-  con->add_option("--dialect", contour->options.dialect, "Output dialect: iso or heidenhain")
-      ->transform(CLI::CheckedTransformer(kDialects, CLI::ignore_case))
+  con->add_option("--dialect", contour->options.dialect, "Output dialect: iso, linuxcnc or heidenhain")
+      ->transform(CLI::CheckedTransformer(dialect_names(), CLI::ignore_case))
       ->capture_default_str();
+  contour->path_mode.add_to(*con);
   con->add_option("-o,--output", contour->output, "Output file, - for standard output")->capture_default_str();
   set_examples(*con, "  servotwin gcode contour --shape circle --size 40 --feed 12000 -o circle.nc\n"
-                     "  servotwin gcode contour --shape diamond -o diamond.nc\n");
+                     "  servotwin gcode contour --shape diamond -o diamond.nc\n"
+                     "  servotwin gcode contour --shape diamond --dialect linuxcnc --path-mode blend:0.05 -o diamond.ngc\n");
   con->callback([contour, &selected] { selected = [contour](const GlobalOptions& g) { return run_contour(*contour, g); }; });
 
   auto check = std::make_shared<ProgramArgs>();
@@ -192,8 +220,8 @@ void register_gcode(CLI::App& app, Action& selected) {
   auto conv = std::make_shared<ProgramArgs>();
   CLI::App* cvt = gcode->add_subcommand("convert", "Rewrite a program in the other dialect");
   add_program_options(*cvt, *conv);
-  cvt->add_option("--to", conv->to, "Output dialect: iso or heidenhain")
-      ->check(CLI::IsMember({"iso", "heidenhain"}))
+  cvt->add_option("--to", conv->to, "Output dialect: iso, linuxcnc or heidenhain")
+      ->check(CLI::IsMember({"iso", "linuxcnc", "heidenhain"}))
       ->capture_default_str();
   cvt->add_option("-o,--output", conv->output, "Output file, - for standard output")->capture_default_str();
   set_examples(*cvt, "  servotwin gcode convert low.h --to iso -o low.nc\n");

@@ -1,10 +1,12 @@
 #include "command.hpp"
 
 #include <cctype>
+#include <charconv>
 #include <cmath>
 
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/program_file.hpp"
+#include "servotwin/motion/gcode.hpp"
 
 namespace servotwin::cli {
 
@@ -45,9 +47,68 @@ std::vector<motion::Axis> parse_axes(const std::vector<std::string>& values, con
   return axes;
 }
 
+const std::map<std::string, motion::Dialect>& dialect_names() {
+  static const std::map<std::string, motion::Dialect> names{
+      {"iso", motion::Dialect::Iso}, {"linuxcnc", motion::Dialect::LinuxCnc}, {"heidenhain", motion::Dialect::Heidenhain}};
+  return names;
+}
+
+const char* dialect_title(motion::Dialect dialect) {
+  switch (dialect) {
+    case motion::Dialect::Iso: return "ISO";
+    case motion::Dialect::LinuxCnc: return "LinuxCNC";
+    case motion::Dialect::Heidenhain: return "Heidenhain";
+  }
+  return "?";
+}
+
+void PathModeOption::add_to(CLI::App& command) {
+  command.add_option("--path-mode", text,
+                     "Path-control mode stated in the program: exact (G61; LinuxCNC G61.1), exact-path (LinuxCNC G61), "
+                     "blend (G64), blend:TOL (G64 P<TOL> in the linuxcnc dialect, Cycle 32 T<TOL> in heidenhain), "
+                     "unstated (no word: the controller's setting). Default: exact, or unstated for heidenhain");
+}
+
+namespace {
+
+std::pair<motion::PathControl, double> path_mode_of(const std::string& text) {
+  const auto fail = [&](const std::string& why) -> std::pair<motion::PathControl, double> {
+    throw core::InputError({"", 0, 0, "--path-mode"}, "'" + text + "': " + why);
+  };
+  if (text == "exact") return {motion::PathControl::ExactStop, 0.0};
+  if (text == "exact-path") return {motion::PathControl::ExactPath, 0.0};
+  if (text == "unstated") return {motion::PathControl::Unstated, 0.0};
+  if (text == "blend") return {motion::PathControl::Blend, 0.0};
+  if (text.rfind("blend:", 0) != 0) return fail("expected exact, exact-path, blend, blend:TOL or unstated");
+  const std::string number = text.substr(6);
+  double tolerance = 0.0;
+  const auto r = std::from_chars(number.data(), number.data() + number.size(), tolerance);
+  if (number.empty() || r.ec != std::errc{} || r.ptr != number.data() + number.size())
+    return fail("expected blend:TOL with TOL a tolerance in mm, e.g. blend:0.01");
+  if (!(tolerance > 0.0 && tolerance <= 1e9)) return fail("the blend tolerance must be > 0 mm");
+  return {motion::PathControl::Blend, tolerance};
+}
+
+}  // namespace
+
+std::pair<std::optional<motion::PathControl>, double> PathModeOption::parse(motion::Dialect dialect) const {
+  if (text.empty()) return {std::nullopt, 0.0};
+  const auto [mode, tolerance] = path_mode_of(text);
+  if (!motion::can_state(dialect, mode, tolerance)) {
+    const std::string hint = dialect == motion::Dialect::Heidenhain
+                                 ? "Heidenhain Klartext has Cycle 32 TOLERANCE (blend:TOL) or the machine's setting (unstated)"
+                                 : "ISO's G64 takes no tolerance: use --dialect linuxcnc for G64 P<TOL>, or plain blend";
+    throw core::InputError({"", 0, 0, "--path-mode"},
+                           "'" + text + "' cannot be written in the " + dialect_title(dialect) + " dialect: " + hint);
+  }
+  return {mode, tolerance};
+}
+
 void add_program_reading_options(CLI::App& command, ProgramSource& source) {
-  command.add_option("--dialect", source.dialect, "Dialect of the program: auto, iso or heidenhain")
-      ->check(CLI::IsMember({"auto", "iso", "heidenhain"}))
+  command.add_option("--dialect", source.dialect,
+                     "Dialect of the program: auto (Heidenhain when it starts with BEGIN PGM, else ISO), iso, linuxcnc "
+                     "(G61 exact path, G61.1 exact stop, G64 P<tol> Q<tol>) or heidenhain")
+      ->check(CLI::IsMember({"auto", "iso", "linuxcnc", "heidenhain"}))
       ->capture_default_str();
   command.add_flag("--lenient", source.lenient, "Report unknown G-code words as warnings instead of errors");
 }
@@ -57,8 +118,7 @@ motion::Program load_program(const ProgramSource& source, const motion::Point& s
   options.lenient = source.lenient;
   options.start = start;
   std::optional<motion::Dialect> dialect;
-  if (source.dialect == "iso") dialect = motion::Dialect::Iso;
-  if (source.dialect == "heidenhain") dialect = motion::Dialect::Heidenhain;
+  if (source.dialect != "auto") dialect = dialect_names().at(source.dialect);
   motion::Program program = io::read_program_file(source.path, options, dialect);
   for (const auto& w : program.warnings)
     fmt::print(stderr, "{}:{}:{}: warning: {}\n", source.path, w.line, w.column, w.message);

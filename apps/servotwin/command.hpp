@@ -7,7 +7,10 @@
 #include <functional>
 #include <memory>
 #include <numbers>
+#include <map>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "servotwin/io/output_file.hpp"
@@ -75,8 +78,23 @@ std::vector<motion::Axis> parse_axes(const std::vector<std::string>& values, con
 /// program shares.
 struct ProgramSource {
   std::string path;
-  std::string dialect = "auto";  ///< auto, iso or heidenhain
+  std::string dialect = "auto";  ///< auto, iso, linuxcnc or heidenhain
   bool lenient = false;
+};
+
+/// Dialects by their option names (iso, linuxcnc, heidenhain), for CLI::CheckedTransformer.
+const std::map<std::string, motion::Dialect>& dialect_names();
+/// "ISO", "LinuxCNC", "Heidenhain".
+const char* dialect_title(motion::Dialect dialect);
+
+/// `--path-mode exact|exact-path|blend[:TOL]|unstated` of the program generators.
+struct PathModeOption {
+  std::string text;  ///< as typed; empty = the dialect's default
+  /// Adds --path-mode to `command`.
+  void add_to(CLI::App& command);
+  /// The mode (empty when not given) and the tolerance [mm]; core::InputError naming --path-mode
+  /// when the text is malformed or `dialect` cannot state the mode.
+  [[nodiscard]] std::pair<std::optional<motion::PathControl>, double> parse(motion::Dialect dialect) const;
 };
 /// Adds --dialect and --lenient for `source`.
 void add_program_reading_options(CLI::App& command, ProgramSource& source);

@@ -21,7 +21,9 @@ struct Extent {
 }  // namespace
 
 void print_prediction_summary(const vcnc::Prediction& p) {
-  fmt::print("prediction: {} samples ({:.3f} s at ts = {} s)\n", p.size(),
+  for (const auto& w : p.warnings) fmt::print(stderr, "warning: {}\n", w);
+  for (const auto& n : p.notes) fmt::print("note: {}\n", n);
+  fmt::print("prediction: {} samples ({:.3f} s at ts = {} s), lengths in mm\n", p.size(),
              static_cast<double>(p.size() > 0 ? p.size() - 1 : 0) * p.ts, p.ts);
   for (std::size_t i = 0; i < p.axes.size(); ++i) {
     Extent e;
@@ -29,7 +31,7 @@ void print_prediction_summary(const vcnc::Prediction& p) {
     fmt::print("  axis {} tracking error: rms {:.4g}, max {:.4g}\n", motion::axis_name(p.axes[i]), e.rms(), e.max);
   }
   Extent all;
-  std::array<Extent, 4> by_kind{};
+  std::array<Extent, motion::kPathKindCount> by_kind{};
   for (std::size_t k = 0; k < p.size(); ++k) {
     all.add(p.contour_error[k]);
     by_kind[static_cast<std::size_t>(p.kind[k])].add(p.contour_error[k]);
@@ -43,9 +45,13 @@ void print_prediction_summary(const vcnc::Prediction& p) {
   fmt::print("\n");
 }
 
-void print_comparison(const vcnc::MeasuredComparison& m, double ts) {
-  fmt::print("measured capture aligned at offset {} samples ({:+.3f} s); {} samples compared; command mismatch rms {:.3g}\n",
-             m.offset, static_cast<double>(m.offset) * ts, m.count, m.command_mismatch_rms);
+void print_comparison(const vcnc::MeasuredComparison& m, double ts, bool from_trace) {
+  if (from_trace) {
+    fmt::print("measured: the trace's own positions, {} samples compared (lengths in mm)\n", m.count);
+  } else {
+    fmt::print("measured capture aligned at offset {} samples ({:+.3f} s); {} samples compared; command mismatch rms {:.3g} mm\n",
+               m.offset, static_cast<double>(m.offset) * ts, m.count, m.command_mismatch_rms);
+  }
   fmt::print("  {:<12} {:<6} {:>12} {:>12} {:>12} {:>8}\n", "quantity", "path", "measured rms", "predicted rms",
              "max |diff|", "nrmse");
   for (const auto& s : m.scores) {

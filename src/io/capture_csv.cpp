@@ -183,7 +183,8 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
                                "); map one with --map t=<column> or give the sample period with --ts");
   for (auto& trace : capture.axes) {
     sinks.push_back({columns.require(trace.name + "_cmd"), trace.name + "_cmd", &trace.cmd, options.scale});
-    sinks.push_back({columns.require(trace.name + "_act"), trace.name + "_act", &trace.act, options.scale});
+    const std::size_t act = options.allow_missing_actual ? columns.find(trace.name + "_act") : columns.require(trace.name + "_act");
+    if (act != std::string::npos) sinks.push_back({act, trace.name + "_act", &trace.act, options.scale});
     const std::size_t u = columns.find(trace.name + "_u");
     if (u != std::string::npos) sinks.push_back({u, trace.name + "_u", &trace.u, 1.0});
   }

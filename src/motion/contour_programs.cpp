@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "gcode_common.hpp"
 #include "servotwin/core/error.hpp"
 
 namespace servotwin::motion {
@@ -77,7 +78,9 @@ Program closed_toolpath(const ContourProgramOptions& o, const char* name, Body b
   p.move(BlockType::Rapid, first, o.feed_mm_min);
   body(p, r, first);
   p.move(BlockType::Rapid, o.center, o.feed_mm_min);
-  return p.finish();
+  Program program = p.finish();
+  detail::state_path_control(program, o.path_control, o.blend_tolerance_mm);
+  return program;
 }
 
 }  // namespace

@@ -303,4 +303,24 @@ void append_shortest(std::string& out, double value) {
   out.append(buf.data(), r.ptr);
 }
 
+void state_path_control(Program& program, std::optional<PathControl> mode, double blend_tolerance_mm) {
+  const auto fail = [](const std::string& message) {
+    throw core::InputError(core::SourceLocation{{}, 0, 0, "path_control"}, message);
+  };
+  if (!(blend_tolerance_mm >= 0.0 && blend_tolerance_mm <= kMaxMagnitude))
+    fail("blend tolerance must be in [0, 1e9] mm, got " + format_number(blend_tolerance_mm));
+  const PathControl m = mode.value_or(program.dialect == Dialect::Heidenhain ? PathControl::Unstated : PathControl::ExactStop);
+  if (m != PathControl::Blend && blend_tolerance_mm > 0.0) fail("a blend tolerance needs the blend mode");
+  if (!can_state(program.dialect, m, blend_tolerance_mm)) {
+    if (program.dialect == Dialect::Heidenhain)
+      fail("Heidenhain Klartext cannot state " + describe_path_control(m, blend_tolerance_mm) +
+           ": it has Cycle 32 TOLERANCE (blend with a tolerance) or the machine's own setting");
+    fail("ISO G64 takes no tolerance: write the program in the LinuxCNC dialect for G64 P<tolerance>");
+  }
+  for (Block& b : program.blocks) {
+    b.path_control = m;
+    b.blend_tolerance_mm = m == PathControl::Blend ? blend_tolerance_mm : 0.0;
+  }
+}
+
 }  // namespace servotwin::motion::detail

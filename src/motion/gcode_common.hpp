@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -146,6 +147,12 @@ std::string check_arc_radius(const Block& block, const ArcTolerance& tolerance);
 bool within_limits(const Point& p) noexcept;
 /// Turns -0.0 into +0.0 (so writers never print "-0.000").
 constexpr double positive_zero(double v) noexcept { return v + 0.0; }
+
+/// Gives every block of a generated program the path-control mode `mode` (when empty: the dialect's
+/// default, exact stop for ISO and LinuxCNC, the machine's setting for Heidenhain, which has no
+/// exact-stop word). core::InputError (field "path_control") when the dialect cannot state it or
+/// the tolerance is negative or not finite.
+void state_path_control(Program& program, std::optional<PathControl> mode, double blend_tolerance_mm);
 
 /// Appends a number by the writers' rule (see WriteOptions): `decimals` decimals when exact, the
 /// shortest exact fixed text otherwise. sign: '\0' = only '-', '+' = always a sign, ' ' = a blank

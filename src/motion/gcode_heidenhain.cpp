@@ -82,6 +82,8 @@ class HeidenhainReader {
     const std::size_t last = lines.line_number() == 0 ? 1 : lines.line_number();
     if (!begun_) report_.error(last, 1, "no 'BEGIN PGM name MM' found: not a Heidenhain conversational program");
     if (dwell_pending_) report_.error(dwell_line_, 1, "CYCL DEF 9.0 must be followed by CYCL DEF 9.1 DWELL <seconds>");
+    if (tolerance_pending_)
+      report_.error(tolerance_line_, 1, "CYCL DEF 32.0 TOLERANCE must be followed by CYCL DEF 32.1 [T<tolerance>]");
     if (!ended_) report_.unsupported(last, 1, "missing 'END PGM " + program_.name + (inch_ ? " INCH'" : " MM'") + " at the end");
   }
 
@@ -100,6 +102,10 @@ class HeidenhainReader {
   bool inch_ = false;
   bool dwell_pending_ = false;
   std::size_t dwell_line_ = 0;
+  bool tolerance_pending_ = false;  ///< CYCL DEF 32.0 read, 32.1 expected
+  std::size_t tolerance_line_ = 0;
+  PathControl control_ = PathControl::Unstated;
+  double tolerance_mm_ = 0.0;
   std::size_t line_no_ = 0;
   std::string_view line_;
 
@@ -123,6 +129,8 @@ class HeidenhainReader {
     block.start = position_;
     block.end = position_;
     block.center = position_;
+    block.path_control = control_;
+    block.blend_tolerance_mm = tolerance_mm_;
     if (detail::is_digit(c.peek())) block.number = read_block_number(c);
     c.skip_blanks();
     if (c.at_end() || c.peek() == ';') {  // number only, or a comment line
@@ -141,6 +149,8 @@ class HeidenhainReader {
       fail(kw_column, "expected 'BEGIN PGM name MM' as the first block, found '" + detail::printable(kw) + "'");
     if (dwell_pending_ && !equals_upper(kw, "CYCL"))
       report_.error(dwell_line_, 1, "CYCL DEF 9.0 must be followed by CYCL DEF 9.1 DWELL <seconds>");
+    if (tolerance_pending_ && !equals_upper(kw, "CYCL"))
+      report_.error(tolerance_line_, 1, "CYCL DEF 32.0 TOLERANCE must be followed by CYCL DEF 32.1 [T<tolerance>]");
     if (equals_upper(kw, "BEGIN")) {
       read_begin(c, kw_column);
     } else if (equals_upper(kw, "END")) {
@@ -626,7 +636,60 @@ class HeidenhainReader {
       return;
     }
     if (dwell_pending_) report_.error(dwell_line_, 1, "CYCL DEF 9.0 must be followed by CYCL DEF 9.1 DWELL <seconds>");
-    report_.unsupported(line_no_, number_col, "cycle '" + word_at(number_col) + "' is not supported (only cycle 9, DWELL TIME)");
+    if (cycle == "32.0" || cycle == "32.1" || cycle == "32.2") {
+      read_tolerance_cycle(c, block, cycle, kw_column);
+      return;
+    }
+    if (tolerance_pending_)
+      report_.error(tolerance_line_, 1, "CYCL DEF 32.0 TOLERANCE must be followed by CYCL DEF 32.1 [T<tolerance>]");
+    report_.unsupported(line_no_, number_col,
+                        "cycle '" + word_at(number_col) + "' is not supported (only cycle 9 DWELL TIME and 32 TOLERANCE)");
+  }
+
+  /// Cycle 32 TOLERANCE: `CYCL DEF 32.0 TOLERANCE`, then `CYCL DEF 32.1 T<tolerance>` (the contour
+  /// deviation the control may take when it smooths corners) or a bare `CYCL DEF 32.1` (back to
+  /// the machine manufacturer's value: the mode is no longer stated), then optionally
+  /// `CYCL DEF 32.2 HSC-MODE:<0|1> [TA<angle>]` (machine filter settings: kept, not interpreted).
+  void read_tolerance_cycle(Cursor& c, Block& block, const std::string& cycle, std::size_t kw_column) {
+    if (cycle == "32.0") {
+      if (tolerance_pending_)
+        report_.error(tolerance_line_, 1, "CYCL DEF 32.0 TOLERANCE must be followed by CYCL DEF 32.1 [T<tolerance>]");
+      expect_word(c, "TOLERANCE", "CYCL DEF 32.0");
+      expect_end(c, nullptr, "CYCL DEF 32.0 TOLERANCE");
+      tolerance_pending_ = true;
+      tolerance_line_ = line_no_;
+      return;
+    }
+    if (cycle == "32.1") {
+      if (!tolerance_pending_) fail(kw_column, "CYCL DEF 32.1 without CYCL DEF 32.0 TOLERANCE before it");
+      tolerance_pending_ = false;
+      c.skip_blanks();
+      if (c.at_end() || c.peek() == ';') {
+        control_ = PathControl::Unstated;
+        tolerance_mm_ = 0.0;
+        return;
+      }
+      const std::size_t col = c.column();
+      if (!equals_upper(c.take_letters(), "T")) fail(col, "expected T<tolerance> after CYCL DEF 32.1");
+      const ScannedNumber n = scan_checked(c, col, "T");
+      const double t = n.value * unit();
+      if (!(t > 0.0 && t <= detail::kMaxMagnitude))
+        fail(col, "tolerance T must be > 0 mm (a bare CYCL DEF 32.1 restores the machine's value)");
+      expect_end(c, nullptr, "CYCL DEF 32.1 T");
+      control_ = PathControl::Blend;
+      tolerance_mm_ = t;
+      return;
+    }
+    if (tolerance_pending_)
+      report_.error(tolerance_line_, 1, "CYCL DEF 32.0 TOLERANCE must be followed by CYCL DEF 32.1 [T<tolerance>]");
+    std::string_view rest = line_.substr(c.pos);
+    const std::size_t semicolon = rest.find(';');
+    if (semicolon != std::string_view::npos) {
+      block.comment = std::string(detail::trim(rest.substr(semicolon + 1)));
+      rest = rest.substr(0, semicolon);
+    }
+    block.statement = "CYCL DEF 32.2 " + std::string(detail::trim(rest));
+    program_.blocks.push_back(std::move(block));
   }
 };
 
@@ -661,8 +724,12 @@ Dialect detect_dialect(std::string_view text) noexcept {
 
 Program parse_program(std::string_view text, std::string_view source_name, const ParseOptions& options,
                       std::optional<Dialect> dialect) {
-  const Dialect d = dialect.value_or(detect_dialect(text));
-  return d == Dialect::Heidenhain ? parse_heidenhain(text, source_name, options) : parse_iso(text, source_name, options);
+  switch (dialect.value_or(detect_dialect(text))) {
+    case Dialect::Heidenhain: return parse_heidenhain(text, source_name, options);
+    case Dialect::LinuxCnc: return parse_linuxcnc(text, source_name, options);
+    case Dialect::Iso: break;
+  }
+  return parse_iso(text, source_name, options);
 }
 
 }  // namespace servotwin::motion

@@ -25,10 +25,10 @@ struct GroupWord {
 
 /// Everything one line says, before it is applied to the modal state.
 struct LineWords {
-  GroupWord motion, dwell, plane, units, distance, arc_distance, feed_mode, compensation;
+  GroupWord motion, dwell, plane, units, distance, arc_distance, feed_mode, compensation, control;
   std::array<ValueWord, kAxisCount> axis{};
   std::array<ValueWord, kAxisCount> offset{};
-  ValueWord radius, p, feed;
+  ValueWord radius, p, q, feed;
   std::size_t first_geometry_column = 0;  ///< column of the first axis/offset/R word
   bool has_number = false;
   bool content = false;
@@ -43,6 +43,9 @@ struct IsoState {
   bool arc_absolute = false;  ///< G90.1
   double feed = 0.0;          ///< mm/min, 0 = none programmed yet
   Point position{};
+  PathControl control = PathControl::Unstated;
+  double blend_tolerance = 0.0;  ///< mm
+  double cam_tolerance = -1.0;   ///< mm, < 0: not written
 };
 
 std::string g_name(int code) {
@@ -54,7 +57,7 @@ std::string g_name(int code) {
 class IsoReader {
  public:
   IsoReader(std::string_view source, const ParseOptions& options, Program& program)
-      : program_(program), report_(source, options.lenient, program.warnings),
+      : program_(program), linuxcnc_(program.dialect == Dialect::LinuxCnc), report_(source, options.lenient, program.warnings),
         tolerance_{options.arc_tolerance_abs_mm, options.arc_tolerance_rel} {
     state_.position = options.start;
   }
@@ -67,6 +70,7 @@ class IsoReader {
 
  private:
   Program& program_;
+  bool linuxcnc_;
   Reporter report_;
   detail::ArcTolerance tolerance_;
   IsoState state_;
@@ -140,6 +144,13 @@ class IsoReader {
         case 'K': read_value(c, w.offset[2], col, "K", &w); break;
         case 'R': read_value(c, w.radius, col, "R", &w); break;
         case 'P': read_value(c, w.p, col, "P", nullptr); break;
+        case 'Q':
+          if (!linuxcnc_) {
+            skip_unknown(c, col);
+          } else {
+            read_value(c, w.q, col, "Q", nullptr);
+          }
+          break;
         case 'F': read_value(c, w.feed, col, "F", nullptr); break;
         default: skip_unknown(c, col); break;
       }
@@ -205,6 +216,15 @@ class IsoReader {
         report_.unsupported(line_no_, col, "'" + word() + "': only feed per minute (G94) is supported");
         break;
       case 400: set_group(w.compensation, code, col, "cutter compensation"); break;
+      case 610: case 640: set_group(w.control, code, col, "path control"); break;
+      case 611:
+        if (linuxcnc_) {
+          set_group(w.control, code, col, "path control");
+        } else {
+          report_.unsupported(line_no_, col, "'" + word() + "' is LinuxCNC's exact stop: read the program with --dialect linuxcnc "
+                                             "(ISO's exact stop is G61)");
+        }
+        break;
       case 410: case 420:
         report_.unsupported(line_no_, col, "'" + word() + "': cutter radius compensation is not supported");
         break;
@@ -224,6 +244,11 @@ class IsoReader {
     if (w.distance.code >= 0) state_.incremental = w.distance.code == 910;
     if (w.arc_distance.code >= 0) state_.arc_absolute = w.arc_distance.code == 901;
     const double unit = state_.inch ? detail::kMmPerInch : 1.0;
+    if (w.control.code >= 0) apply_control(w, unit);
+    if (w.q.present && w.control.code != 640) fail(w.q.column, "Q is only used with G64 (naive-CAM tolerance)");
+    block.path_control = state_.control;
+    block.blend_tolerance_mm = state_.blend_tolerance;
+    block.cam_tolerance_mm = state_.cam_tolerance;
     if (w.feed.present) {
       const double f = w.feed.value * unit;
       if (!(f > 0.0)) fail(w.feed.column, "feed F must be > 0 (got " + detail::format_number(w.feed.value) + ")");
@@ -239,7 +264,9 @@ class IsoReader {
       return;
     }
     if (w.motion.code >= 0) state_.motion = w.motion.code;
-    if (w.p.present) fail(w.p.column, "P is only used with G04 (dwell time in seconds)");
+    if (w.p.present && !(linuxcnc_ && w.control.code == 640))
+      fail(w.p.column, linuxcnc_ ? "P is only used with G04 (dwell time in seconds) and G64 (blend tolerance)"
+                                 : "P is only used with G04 (dwell time in seconds)");
     const bool has_axes = w.axis[0].present || w.axis[1].present || w.axis[2].present;
     const bool has_offsets = w.offset[0].present || w.offset[1].present || w.offset[2].present;
     if (!has_axes && !has_offsets && !w.radius.present) return;  // modal words only: a None block
@@ -274,6 +301,34 @@ class IsoReader {
       }
     }
     state_.position = block.end;
+  }
+
+  /// G61 / G61.1 / G64 [P [Q]]. ISO (Fanuc) G64 takes no tolerance; LinuxCNC's P and Q are in
+  /// program units, P0 means the same as G64 alone (LinuxCNC G-code reference, G64).
+  void apply_control(const LineWords& w, double unit) {
+    state_.blend_tolerance = 0.0;
+    state_.cam_tolerance = -1.0;
+    switch (w.control.code) {
+      case 610: state_.control = linuxcnc_ ? PathControl::ExactPath : PathControl::ExactStop; return;
+      case 611: state_.control = PathControl::ExactStop; return;
+      default: break;
+    }
+    state_.control = PathControl::Blend;
+    if (w.p.present) {
+      if (!linuxcnc_)
+        fail(w.p.column, "G64 P<tolerance> is LinuxCNC syntax: read the program with --dialect linuxcnc "
+                         "(ISO's G64 takes no tolerance)");
+      if (w.dwell.code >= 0) fail(w.p.column, "P of G64 and of G04 on one line: write the dwell on a line of its own");
+      if (!(w.p.value >= 0.0 && w.p.value * unit <= detail::kMaxMagnitude))
+        fail(w.p.column, "blend tolerance P must be >= 0 (got " + detail::format_number(w.p.value) + ")");
+      state_.blend_tolerance = w.p.value * unit;
+    }
+    if (w.q.present) {
+      if (!(w.q.value >= 0.0 && w.q.value * unit <= detail::kMaxMagnitude))
+        fail(w.q.column, "naive-CAM tolerance Q must be >= 0 (got " + detail::format_number(w.q.value) + ")");
+      if (!w.p.present) fail(w.q.column, "G64 Q needs P before it (G64 P<blend tolerance> Q<naive-CAM tolerance>)");
+      state_.cam_tolerance = w.q.value * unit;
+    }
   }
 
   static std::size_t first_present(const std::array<ValueWord, kAxisCount>& words) {
@@ -338,16 +393,29 @@ class IsoReader {
 
 }  // namespace
 
-Program parse_iso(std::string_view text, std::string_view source_name, const ParseOptions& options) {
+namespace {
+
+Program parse_iso_dialect(std::string_view text, std::string_view source_name, const ParseOptions& options,
+                          Dialect dialect) {
   detail::check_tolerances(options);
   Program program;
   program.name = std::string(source_name);
-  program.dialect = Dialect::Iso;
+  program.dialect = dialect;
   program.start = options.start;
   program.blocks.reserve(detail::reserve_hint(text));
   IsoReader reader(source_name, options, program);
   reader.read(text);
   return program;
+}
+
+}  // namespace
+
+Program parse_iso(std::string_view text, std::string_view source_name, const ParseOptions& options) {
+  return parse_iso_dialect(text, source_name, options, Dialect::Iso);
+}
+
+Program parse_linuxcnc(std::string_view text, std::string_view source_name, const ParseOptions& options) {
+  return parse_iso_dialect(text, source_name, options, Dialect::LinuxCnc);
 }
 
 }  // namespace servotwin::motion

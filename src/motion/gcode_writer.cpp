@@ -85,7 +85,8 @@ void append_word(std::string& line, std::string_view word) {
 
 class IsoWriter {
  public:
-  explicit IsoWriter(const WriteOptions& o) : o_(o), sign_(o.sign_column ? ' ' : '\0') {}
+  IsoWriter(const WriteOptions& o, Dialect dialect)
+      : o_(o), sign_(o.sign_column ? ' ' : '\0'), linuxcnc_(dialect == Dialect::LinuxCnc) {}
 
   std::string write(const Program& program) {
     std::string out;
@@ -95,6 +96,13 @@ class IsoWriter {
       check_block(b, i);
       if (b.type == BlockType::None && b.m_codes.empty() && b.comment.empty() && b.statement.empty()) continue;
       line_.clear();
+      if (b.type == BlockType::Dwell && control_changes(b)) {
+        // A dwell's P would clash with G64's P: the mode goes on a line of its own.
+        write_control(b);
+        out += line_;
+        out += '\n';
+        line_.clear();
+      }
       write_block(b);
       out += line_;
       out += '\n';
@@ -105,10 +113,43 @@ class IsoWriter {
  private:
   const WriteOptions& o_;
   char sign_;
+  bool linuxcnc_;
   std::string line_;
   Plane plane_ = Plane::XY;
   double feed_ = 0.0;
   bool first_ = true;
+  std::string control_;  ///< the path-control words written last
+
+  /// ISO (Fanuc): G61 exact stop, G64 cutting mode without a tolerance; ISO has no exact-path
+  /// mode, so LinuxCNC's G61 becomes the stricter G61. LinuxCNC: G61.1, G61, G64 [P [Q]]. A return
+  /// to "not stated" has no word.
+  [[nodiscard]] std::string control_words(const Block& b) const {
+    switch (b.path_control) {
+      case PathControl::Unstated: return {};
+      case PathControl::ExactStop: return linuxcnc_ ? "G61.1" : "G61";
+      case PathControl::ExactPath: return "G61";
+      case PathControl::Blend: break;
+    }
+    std::string words = "G64";
+    if (!linuxcnc_ || !(b.blend_tolerance_mm > 0.0)) return words;
+    words += " P";
+    append_number(words, b.blend_tolerance_mm, o_.decimals, '\0');
+    if (b.cam_tolerance_mm < 0.0) return words;
+    words += " Q";
+    append_number(words, b.cam_tolerance_mm, o_.decimals, '\0');
+    return words;
+  }
+
+  [[nodiscard]] bool control_changes(const Block& b) const {
+    const std::string words = control_words(b);
+    return !words.empty() && words != control_;
+  }
+
+  void write_control(const Block& b) {
+    if (!control_changes(b)) return;
+    control_ = control_words(b);
+    append_word(line_, control_);
+  }
 
   void number_word(char letter, double value) {
     line_ += ' ';
@@ -133,6 +174,7 @@ class IsoWriter {
       append_word(line_, detail::plane_gcode(b.plane));
       plane_ = b.plane;
     }
+    write_control(b);
     switch (b.type) {
       case BlockType::Rapid:
       case BlockType::Linear:
@@ -224,6 +266,34 @@ class HeidenhainWriter {
   bool has_center_ = false;
   Point center_{};
   Plane center_plane_ = Plane::XY;
+  PathControl control_ = PathControl::Unstated;
+  double tolerance_ = 0.0;
+
+  /// Cycle 32 TOLERANCE is the dialect's means (T: the contour deviation the control may take when
+  /// it smooths corners; a bare 32.1 restores the machine's own value). Klartext has no exact-stop
+  /// or tolerance-free blending word: such a mode is written as a comment, once.
+  void path_control(const Block& b) {
+    if (b.path_control == control_ && (b.path_control != PathControl::Blend || b.blend_tolerance_mm == tolerance_)) return;
+    control_ = b.path_control;
+    tolerance_ = b.blend_tolerance_mm;
+    const bool cycle = control_ == PathControl::Unstated || (control_ == PathControl::Blend && tolerance_ > 0.0);
+    if (!cycle) {
+      start_line();
+      line_ += ";path control: " + describe_path_control(control_, tolerance_) + " - not expressible in Klartext";
+      end_line();
+      return;
+    }
+    start_line();
+    line_ += "CYCL DEF 32.0 TOLERANCE";
+    end_line();
+    start_line();
+    line_ += "CYCL DEF 32.1";
+    if (control_ == PathControl::Blend) {
+      line_ += " T";
+      append_number(line_, tolerance_, o_.decimals, '\0');
+    }
+    end_line();
+  }
 
   void start_line() {
     line_.clear();
@@ -270,6 +340,7 @@ class HeidenhainWriter {
   }
 
   void write_block(const Block& b) {
+    path_control(b);
     switch (b.type) {
       case BlockType::None: write_none(b); break;
       case BlockType::Rapid:
@@ -365,7 +436,12 @@ class HeidenhainWriter {
 
 std::string write_iso(const Program& program, const WriteOptions& options) {
   check_options(options);
-  return IsoWriter(options).write(program);
+  return IsoWriter(options, Dialect::Iso).write(program);
+}
+
+std::string write_linuxcnc(const Program& program, const WriteOptions& options) {
+  check_options(options);
+  return IsoWriter(options, Dialect::LinuxCnc).write(program);
 }
 
 std::string write_heidenhain(const Program& program, const WriteOptions& options) {
@@ -374,7 +450,21 @@ std::string write_heidenhain(const Program& program, const WriteOptions& options
 }
 
 std::string write_program(const Program& program, const WriteOptions& options) {
-  return program.dialect == Dialect::Heidenhain ? write_heidenhain(program, options) : write_iso(program, options);
+  switch (program.dialect) {
+    case Dialect::Heidenhain: return write_heidenhain(program, options);
+    case Dialect::LinuxCnc: return write_linuxcnc(program, options);
+    case Dialect::Iso: break;
+  }
+  return write_iso(program, options);
+}
+
+bool can_state(Dialect dialect, PathControl mode, double blend_tolerance_mm) noexcept {
+  switch (dialect) {
+    case Dialect::LinuxCnc: return true;
+    case Dialect::Iso: return mode != PathControl::Blend || !(blend_tolerance_mm > 0.0);
+    case Dialect::Heidenhain: return mode == PathControl::Unstated || (mode == PathControl::Blend && blend_tolerance_mm > 0.0);
+  }
+  return false;
 }
 
 }  // namespace servotwin::motion

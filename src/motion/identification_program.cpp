@@ -217,7 +217,7 @@ Program make_identification_program(const IdentificationOptions& o) {
   program.dialect = o.dialect;
   program.blocks.reserve(moves.size() + 8);
   Point at = program.start;
-  const bool iso = o.dialect == Dialect::Iso;
+  const bool iso = o.dialect != Dialect::Heidenhain;
   long number = iso ? 0 : 1;
   const long step = iso ? 10 : 1;
   const auto add = [&](Block b) {
@@ -287,6 +287,7 @@ Program make_identification_program(const IdentificationOptions& o) {
   Block end;
   end.m_codes.push_back(30);
   add(std::move(end));
+  detail::state_path_control(program, o.path_control, o.blend_tolerance_mm);
   return program;
 }
 

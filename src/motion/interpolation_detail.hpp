@@ -68,6 +68,7 @@ struct Segment {
   double feed = 0.0;       ///< speed limit from the program [mm/s]
   double s_begin = 0.0;    ///< path position of the start along the whole program
   bool stop_before = false;  ///< exact stop at the start (program start, dwell, sharp corner)
+  PathControl control = PathControl::Unstated;  ///< the block's mode: it governs the junction at the end
 };
 
 struct Dwell {
@@ -153,6 +154,10 @@ double peak_speed(double v0, double v1, double len, const PieceLimits& lim) noex
 
 /// Plans the profiles of all chains, fills phases, spans, moves and the sample count.
 void plan_profiles(const Path& path, const std::vector<Piece>& pieces, const Program& program, PlanData& plan);
+
+/// Path position along the whole program (Segment::s_begin + segment-local s) at every sample of
+/// the plan, walked like sample_into (interpolation_sampling.cpp).
+std::vector<double> sample_path_positions(const PlanData& plan);
 
 /// Evaluates the path position of a phase at chain-local time t.
 inline double phase_position(const Phase& p, double t) noexcept {

@@ -206,6 +206,7 @@ Path build_path(const Program& program, const InterpolationLimits& limits) {
                                                " but the previous block ended at " + format_point(current));
     Segment seg;
     seg.block = i;
+    seg.control = b.path_control;
     if (b.type == BlockType::Rapid || b.type == BlockType::Linear) {
       if (b.end == current) continue;  // zero-length move
       seg.geo = make_line(current, b.end);

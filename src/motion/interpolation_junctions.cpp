@@ -66,8 +66,14 @@ void mark_exact_stops(Path& path, const InterpolationLimits& limits) {
       seg.stop_before = true;
       continue;
     }
-    const Geometry& prev = path.segments[i - 1].geo;
-    seg.stop_before = angle_between(prev.tangent(prev.length), seg.geo.tangent(0.0)) > corner;
+    const Segment& prev = path.segments[i - 1];
+    // The previous block's mode governs the junction at its end (see Block::path_control).
+    if (prev.control == PathControl::ExactStop) {
+      seg.stop_before = true;
+      continue;
+    }
+    const double limit = prev.control == PathControl::ExactPath ? 1e-9 : corner;
+    seg.stop_before = angle_between(prev.geo.tangent(prev.geo.length), seg.geo.tangent(0.0)) > limit;
   }
 }
 

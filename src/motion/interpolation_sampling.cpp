@@ -203,4 +203,27 @@ double MotionPlan::speed_at(double t) const {
   return detail::phase_speed(find_phase(d, *span, tau), tau) / k;
 }
 
+std::vector<double> detail::sample_path_positions(const PlanData& d) {
+  std::vector<double> out;
+  out.reserve(d.sample_count);
+  double s = 0.0;
+  out.push_back(s);
+  for (const Span& span : d.spans) {
+    if (span.phase_begin != span.phase_end) {
+      const double dt = span.duration / static_cast<double>(span.samples);
+      std::size_t ph = span.phase_begin;
+      for (std::size_t m = 1; m < span.samples; ++m) {
+        const double t = static_cast<double>(m) * dt;
+        while (ph + 1 < span.phase_end && t > d.phases[ph].t1) ++ph;
+        const Phase& p = d.phases[ph];
+        out.push_back(d.segments[p.segment].s_begin + detail::phase_position(p, t));
+      }
+      const Segment& last = d.segments[d.phases[span.phase_end - 1].segment];
+      s = last.s_begin + last.geo.length;  // the chain ends exactly at its last segment's end
+    }
+    out.insert(out.end(), span.phase_begin == span.phase_end ? span.samples : 1, s);
+  }
+  return out;
+}
+
 }  // namespace servotwin::motion

@@ -1,5 +1,7 @@
 #include "servotwin/motion/program.hpp"
 
+#include <charconv>
+
 namespace servotwin::motion {
 
 char axis_letter(Axis a) noexcept {
@@ -31,6 +33,35 @@ std::uint8_t plane_axes(Plane plane) noexcept {
   return 0;
 }
 }  // namespace
+
+std::string describe_path_control(PathControl mode, double blend_tolerance_mm) {
+  switch (mode) {
+    case PathControl::Unstated: return "path control not stated";
+    case PathControl::ExactStop: return "exact stop at every block end";
+    case PathControl::ExactPath: return "exact path (stops at corners, tangent moves run on)";
+    case PathControl::Blend: break;
+  }
+  if (!(blend_tolerance_mm > 0.0)) return "corners blended, no tolerance stated";
+  char text[32];
+  const auto r = std::to_chars(text, text + sizeof text, blend_tolerance_mm);
+  return "corners blended within " + std::string(text, r.ptr) + " mm";
+}
+
+namespace {
+bool moves(const Block& b) noexcept { return b.type != BlockType::None && b.type != BlockType::Dwell; }
+}  // namespace
+
+bool Program::states_path_control() const noexcept {
+  for (const Block& b : blocks)
+    if (moves(b) && b.path_control != PathControl::Unstated) return true;
+  return false;
+}
+
+bool Program::blends() const noexcept {
+  for (const Block& b : blocks)
+    if (moves(b) && b.path_control == PathControl::Blend) return true;
+  return false;
+}
 
 std::uint8_t Program::used_axes() const noexcept {
   std::uint8_t mask = 0;

@@ -64,7 +64,7 @@ Section summary_section(const std::string& name, const vcnc::Prediction& p, cons
     predicted.rows.push_back({std::string(motion::axis_name(p.axes[i])) + " tracking", "all", um(e.rms()), um(e.max)});
   }
   Extent all;
-  std::array<Extent, 4> by_kind{};
+  std::array<Extent, motion::kPathKindCount> by_kind{};
   for (std::size_t k = 0; k < p.size(); ++k) {
     all.add(p.contour_error[k]);
     by_kind[static_cast<std::size_t>(p.kind[k])].add(p.contour_error[k]);
@@ -188,7 +188,7 @@ Section path_section(const std::string& name, const vcnc::Prediction& p, const v
         out.x[k] = out.y[k] = std::nan("");
         continue;
       }
-      const motion::ContourPoint c = p.path->nearest(q, static_cast<double>(k) * p.ts, p.contour_window_s);
+      const motion::ContourPoint c = p.path->nearest(k, q);
       out.x[k] = c.nearest[a] + factor * (q[a] - c.nearest[a]);
       out.y[k] = c.nearest[b] + factor * (q[b] - c.nearest[b]);
     }

@@ -6,6 +6,8 @@
 #include <limits>
 #include <optional>
 
+#include <fmt/format.h>
+
 #include "servotwin/core/error.hpp"
 
 namespace servotwin::vcnc {
@@ -45,10 +47,32 @@ std::array<const AxisModelSpec*, motion::kAxisCount> models_by_axis(const std::v
   return by_axis;
 }
 
-std::vector<motion::PathKind> kinds_of(const motion::ContourPath& path, std::size_t n, double ts) {
+std::vector<motion::PathKind> kinds_of(const motion::ContourReference& path, std::size_t n) {
   std::vector<motion::PathKind> kind(n);
-  for (std::size_t k = 0; k < n; ++k) kind[k] = path.kind_at(static_cast<double>(k) * ts);
+  for (std::size_t k = 0; k < n; ++k) kind[k] = path.kind(k);
   return kind;
+}
+
+/// Warnings and notes on how the program's path-control modes enter a prediction from servotwin's
+/// own interpolation.
+void note_path_control(const motion::Program& program, const std::string& program_name,
+                       const motion::InterpolationLimits& limits, Prediction& out) {
+  const bool heidenhain = program.dialect == motion::Dialect::Heidenhain;
+  if (!program.states_path_control()) {
+    out.warnings.push_back(fmt::format(
+        "{} states no path-control mode ({}): corners sharper than {} deg are taken as exact stops and shallower "
+        "ones at feed, which need not be what the controller does by default (LinuxCNC blends); state the mode in "
+        "the program (servotwin gcode ... --path-mode)",
+        program_name, heidenhain ? "no Cycle 32 TOLERANCE: the machine's own tolerance applies" : "no G61 or G64",
+        limits.corner_angle_deg));
+  }
+  if (program.blends()) {
+    out.notes.push_back(fmt::format(
+        "{} blends corners ({}): servotwin's planner passes corners up to {} deg on the programmed path at a capped "
+        "speed and stops at sharper ones, it does not round them the controller's way; a prediction from the "
+        "controller's recorded command (servotwin predict --command trace.csv) is the reliable one",
+        program_name, heidenhain ? "Cycle 32" : "G64", limits.corner_angle_deg));
+  }
 }
 
 }  // namespace
@@ -86,10 +110,156 @@ Prediction predict(const motion::Program& program, const std::string& program_na
     sim.initial_position = out.command[i].front();
     out.predicted[i] = spec.model.simulate(out.command[i], sim).position;
   }
-  auto path = std::make_shared<motion::ContourPath>(program, plan);
-  out.contour_error = motion::contour_errors(*path, out.axes, out.predicted, out.ts, options.contour_window_s);
-  out.kind = kinds_of(*path, trajectory.size(), out.ts);
+  auto path = std::make_shared<motion::ContourPath>(program, plan, options.contour_window_s);
+  out.contour_error = motion::contour_errors(*path, out.axes, out.predicted);
+  out.kind = kinds_of(*path, trajectory.size());
   out.path = std::move(path);
+  if (!limits.exact_stop_every_block) note_path_control(program, program_name, limits, out);
+  return out;
+}
+
+namespace {
+
+/// The largest distance a controller's command may keep from the program's path: its rounding,
+/// plus the stated blend tolerance, or 10 % of the motion range where the blending is not bounded.
+double default_path_tolerance(const motion::Program& program, double range) {
+  const double rounding = 0.01 + 1e-4 * range;
+  double blend = 0.0;
+  bool unbounded = !program.states_path_control();
+  for (const motion::Block& b : program.blocks) {
+    if (b.type == motion::BlockType::None || b.type == motion::BlockType::Dwell) continue;
+    if (b.path_control != motion::PathControl::Blend) continue;
+    if (b.blend_tolerance_mm > 0.0) {
+      blend = std::max(blend, b.blend_tolerance_mm);
+    } else {
+      unbounded = true;
+    }
+  }
+  return rounding + (unbounded ? 0.1 * range : blend);
+}
+
+double column_range(const std::vector<double>& v) {
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+  return *hi - *lo;
+}
+
+/// The trace's command of every axis it has (for matching a program).
+motion::Trajectory trace_command(const core::Capture& trace, const std::string& trace_name) {
+  motion::Trajectory t;
+  t.ts = trace.ts;
+  for (std::size_t i = 0; i < motion::kAxisCount; ++i) {
+    const auto axis = static_cast<motion::Axis>(i);
+    const core::AxisTrace* a = trace.find(motion::axis_name(axis));
+    if (a == nullptr) continue;
+    if (a->cmd.size() != trace.size())
+      throw error_at(trace_name, std::string(motion::axis_name(axis)) + "_cmd", "the command column has another length");
+    t.axes.push_back(axis);
+    t.positions.push_back(a->cmd);
+  }
+  return t;
+}
+
+std::shared_ptr<const motion::ContourReference> program_reference(const core::Capture& trace, const std::string& trace_name,
+                                                                  const motion::Program& program,
+                                                                  const std::string& program_name,
+                                                                  const CommandPredictionOptions& options, Prediction& out) {
+  const motion::Trajectory command = trace_command(trace, trace_name);
+  double range = 0.0;
+  for (const auto& column : command.positions) range = std::max(range, column_range(column));
+  motion::CommandMatchOptions match_options;
+  match_options.window_s = options.contour_window_s;
+  match_options.tolerance_mm = options.path_tolerance_mm.value_or(default_path_tolerance(program, range));
+  match_options.offset = options.offset;
+  auto path = std::make_shared<motion::ContourPath>(motion::ContourPath::from_command(program, command, match_options));
+  const motion::CommandMatch& m = path->match();
+  if (m.max_deviation > match_options.tolerance_mm) {
+    throw error_at(trace_name, "",
+                   fmt::format("the trace's commanded path leaves {}'s path by {:.4g} mm at t = {:.4g} s (sample {}), more "
+                               "than the tolerance {:.4g} mm{}: is it a run of this program (same coordinates, or "
+                               "give --offset)?",
+                               program_name, m.max_deviation, trace.time(m.worst_sample), m.worst_sample,
+                               match_options.tolerance_mm, options.path_tolerance_mm ? "" : " (set it with --path-tolerance)"));
+  }
+  if (m.progress_end < 0.5 * m.path_length) {
+    throw error_at(trace_name, "",
+                   fmt::format("the trace's command covers {:.4g} mm of {}'s {:.4g} mm path: is it a run of this program?",
+                               m.progress_end, program_name, m.path_length));
+  }
+  if (m.progress_end < m.path_length - match_options.tolerance_mm) {
+    out.warnings.push_back(fmt::format("the trace ends before {} does: its command covers {:.4g} of {:.4g} mm of the path",
+                                       program_name, m.progress_end, m.path_length));
+  }
+  if (m.offset != motion::Point{0.0, 0.0, 0.0}) {
+    out.notes.push_back(fmt::format("the trace is offset from {}'s coordinates by X {:.6g} Y {:.6g} Z {:.6g} mm", program_name,
+                                    m.offset[0], m.offset[1], m.offset[2]));
+  }
+  out.notes.push_back(fmt::format("the trace's command keeps within {:.3g} mm of {}'s path (RMS {:.3g} mm): contour errors "
+                                  "are measured against the programmed lines and arcs",
+                                  m.max_deviation, program_name, m.rms_deviation));
+  return path;
+}
+
+}  // namespace
+
+Prediction predict_from_command(const core::Capture& trace, const std::string& trace_name, const motion::Program* program,
+                                const std::string& program_name, const std::vector<AxisModelSpec>& models,
+                                const CommandPredictionOptions& options) {
+  const auto by_axis = models_by_axis(models);
+  if (trace.size() < 2) throw error_at(trace_name, "", "the trace has fewer than 2 samples");
+  const double ts = models.front().model.ts();
+  if (std::abs(trace.ts - ts) > 1e-6 * ts) {
+    throw error_at(trace_name, "t",
+                   fmt::format("the trace's sample period {:.6g} s differs from the models' {:.6g} s ({}): identify the "
+                               "models from a trace at the same rate",
+                               trace.ts, ts, models.front().source));
+  }
+  std::uint8_t moved = program != nullptr ? program->used_axes() : 0;
+  if (program == nullptr) {
+    for (const core::AxisTrace& a : trace.axes) {
+      const auto axis = axis_of(a.name);
+      const double range = a.cmd.empty() ? 0.0 : column_range(a.cmd);
+      if (axis && range > 1e-9 * (std::abs(a.cmd.front()) + 1.0)) moved = static_cast<std::uint8_t>(moved | motion::axis_bit(*axis));
+    }
+  }
+  Prediction out;
+  out.ts = trace.ts;
+  out.contour_window_s = options.contour_window_s;
+  for (std::size_t i = 0; i < motion::kAxisCount; ++i) {
+    const auto axis = static_cast<motion::Axis>(i);
+    const std::string name = motion::axis_name(axis);
+    if (by_axis[i] == nullptr) {
+      if ((moved & motion::axis_bit(axis)) != 0)
+        throw error_at(program != nullptr ? program_name : trace_name, program != nullptr ? "" : name + "_cmd",
+                       "axis " + name + " moves but no model is given for it (add --model with axis " + name + ")");
+      continue;
+    }
+    const core::AxisTrace* a = trace.find(name);
+    if (a == nullptr || a->cmd.size() != trace.size())
+      throw error_at(trace_name, name + "_cmd",
+                     "the trace has no commanded position of axis " + name + ", which " + by_axis[i]->source + " models");
+    out.axes.push_back(axis);
+    out.command.push_back(a->cmd);
+  }
+  out.predicted.resize(out.axes.size());
+  for (std::size_t i = 0; i < out.axes.size(); ++i) {
+    const AxisModelSpec& spec = *by_axis[static_cast<std::size_t>(out.axes[i])];
+    rapid::ModelSimulationOptions sim;
+    sim.command_shift = spec.command_shift;
+    sim.initial_position = out.command[i].front();
+    out.predicted[i] = spec.model.simulate(out.command[i], sim).position;
+  }
+  if (program != nullptr) {
+    out.path = program_reference(trace, trace_name, *program, program_name, options, out);
+  } else {
+    motion::Trajectory command;
+    command.ts = trace.ts;
+    command.axes = out.axes;
+    command.positions = out.command;
+    out.path = std::make_shared<motion::CommandPolyline>(command, options.contour_window_s);
+    out.notes.push_back("no program given: contour errors are measured against the trace's own commanded path");
+  }
+  out.contour_error = motion::contour_errors(*out.path, out.axes, out.predicted);
+  out.kind = kinds_of(*out.path, trace.size());
   return out;
 }
 
@@ -141,7 +311,8 @@ void add_scores(MeasuredComparison& out, const std::string& quantity, const std:
   out.scores.push_back({quantity, "all",
                         rapid::compare_tracking(std::span(measured).subspan(begin, out.count),
                                                 std::span(predicted).subspan(begin, out.count))});
-  for (const auto k : {motion::PathKind::Line, motion::PathKind::Arc, motion::PathKind::Rapid, motion::PathKind::Stop}) {
+  for (std::size_t kk = 0; kk < motion::kPathKindCount; ++kk) {
+    const auto k = static_cast<motion::PathKind>(kk);
     std::vector<double> m, p;
     for (std::size_t s = begin; s < end; ++s) {
       if (kind[s] != k) continue;
@@ -150,6 +321,40 @@ void add_scores(MeasuredComparison& out, const std::string& quantity, const std:
     }
     if (m.size() >= 10) out.scores.push_back({quantity, motion::path_kind_name(k), rapid::compare_tracking(m, p)});
   }
+}
+
+}  // namespace
+
+namespace {
+
+/// Measured positions, tracking and contour errors and the scores over prediction samples
+/// [out.first, out.first + out.count), capture sample = prediction sample + out.offset.
+void fill_measurement(const Prediction& prediction, const std::vector<const std::vector<double>*>& captured_cmd,
+                      const std::vector<const std::vector<double>*>& captured_act, MeasuredComparison& out) {
+  const std::size_t n = prediction.size();
+  const auto at = [&](std::size_t k) { return static_cast<std::size_t>(static_cast<std::ptrdiff_t>(k) + out.offset); };
+  out.actual.assign(prediction.axes.size(), std::vector<double>(n, kNaN));
+  for (std::size_t i = 0; i < prediction.axes.size(); ++i) {
+    for (std::size_t k = out.first; k < out.first + out.count; ++k) out.actual[i][k] = (*captured_act[i])[at(k)];
+  }
+  out.contour_error.assign(n, kNaN);
+  motion::Point p = prediction.path->start_point();
+  for (std::size_t k = out.first; k < out.first + out.count; ++k) {
+    for (std::size_t i = 0; i < prediction.axes.size(); ++i) p[static_cast<std::size_t>(prediction.axes[i])] = out.actual[i][k];
+    out.contour_error[k] = prediction.path->nearest(k, p).signed_distance;
+  }
+  out.tracking_error.assign(prediction.axes.size(), std::vector<double>(n, kNaN));
+  for (std::size_t i = 0; i < prediction.axes.size(); ++i) {
+    std::vector<double> predicted(n, 0.0);
+    for (std::size_t k = out.first; k < out.first + out.count; ++k) {
+      // The measured tracking error is the capture's own: its command minus its position.
+      out.tracking_error[i][k] = (*captured_cmd[i])[at(k)] - out.actual[i][k];
+      predicted[k] = prediction.tracking_error(i, k);
+    }
+    add_scores(out, std::string(motion::axis_name(prediction.axes[i])) + " tracking", out.tracking_error[i], predicted,
+               prediction.kind);
+  }
+  add_scores(out, "contour", out.contour_error, prediction.contour_error, prediction.kind);
 }
 
 }  // namespace
@@ -191,7 +396,9 @@ MeasuredComparison compare_with_capture(const Prediction& prediction, const core
   if (best.rms > 1e-3 * range + 1e-9) {
     throw error_at(source, "", "the capture's commanded positions differ from the program's by " + std::to_string(best.rms) +
                                    " RMS after the best time alignment (motion range " + std::to_string(range) +
-                                   "): is it a capture of this program, with the same feed and acceleration?");
+                                   "): is it a capture of this program, with the same feed and acceleration? A real "
+                                   "controller's look-ahead and blending never match servotwin's: predict from the "
+                                   "trace's own command instead (servotwin predict --command)");
   }
 
   MeasuredComparison out;
@@ -199,33 +406,29 @@ MeasuredComparison compare_with_capture(const Prediction& prediction, const core
   out.first = best.first;
   out.count = best.count;
   out.command_mismatch_rms = best.rms;
-  const std::size_t n = prediction.size();
-  out.actual.assign(prediction.axes.size(), std::vector<double>(n, kNaN));
-  for (std::size_t i = 0; i < prediction.axes.size(); ++i) {
-    for (std::size_t k = out.first; k < out.first + out.count; ++k)
-      out.actual[i][k] = (*captured_act[i])[static_cast<std::size_t>(static_cast<std::ptrdiff_t>(k) + out.offset)];
-  }
-  out.contour_error.assign(n, kNaN);
-  motion::Point p = prediction.path->start_point();
-  for (std::size_t k = out.first; k < out.first + out.count; ++k) {
-    for (std::size_t i = 0; i < prediction.axes.size(); ++i) p[static_cast<std::size_t>(prediction.axes[i])] = out.actual[i][k];
-    out.contour_error[k] =
-        prediction.path->nearest(p, static_cast<double>(k) * prediction.ts, prediction.contour_window_s).signed_distance;
-  }
+  fill_measurement(prediction, captured_cmd, captured_act, out);
+  return out;
+}
 
-  out.tracking_error.assign(prediction.axes.size(), std::vector<double>(n, kNaN));
-  for (std::size_t i = 0; i < prediction.axes.size(); ++i) {
-    std::vector<double> predicted(n, 0.0);
-    for (std::size_t k = out.first; k < out.first + out.count; ++k) {
-      // The measured tracking error is the capture's own: its command minus its position.
-      out.tracking_error[i][k] =
-          (*captured_cmd[i])[static_cast<std::size_t>(static_cast<std::ptrdiff_t>(k) + out.offset)] - out.actual[i][k];
-      predicted[k] = prediction.tracking_error(i, k);
-    }
-    add_scores(out, std::string(motion::axis_name(prediction.axes[i])) + " tracking", out.tracking_error[i], predicted,
-               prediction.kind);
+MeasuredComparison compare_with_trace(const Prediction& prediction, const core::Capture& trace, const std::string& source) {
+  if (prediction.size() == 0) throw core::InputError("empty prediction");
+  if (trace.size() != prediction.size())
+    throw error_at(source, "", "the trace has " + std::to_string(trace.size()) + " samples but the prediction " +
+                                   std::to_string(prediction.size()) + ": it was not made from this trace");
+  std::vector<const std::vector<double>*> captured_cmd, captured_act;
+  for (const motion::Axis axis : prediction.axes) {
+    const std::string name = motion::axis_name(axis);
+    const core::AxisTrace* t = trace.find(name);
+    if (t == nullptr || t->act.size() != trace.size())
+      throw error_at(source, name + "_act", "the trace has no measured position of axis " + name);
+    captured_cmd.push_back(&t->cmd);
+    captured_act.push_back(&t->act);
   }
-  add_scores(out, "contour", out.contour_error, prediction.contour_error, prediction.kind);
+  MeasuredComparison out;
+  out.count = prediction.size();
+  if (const auto* path = dynamic_cast<const motion::ContourPath*>(prediction.path.get()))
+    out.command_mismatch_rms = path->match().rms_deviation;
+  fill_measurement(prediction, captured_cmd, captured_act, out);
   return out;
 }
 

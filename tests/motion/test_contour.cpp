@@ -35,6 +35,24 @@ double mid_time(const MotionPlan& plan, std::size_t block) {
   return 0.0;
 }
 
+/// Time (on the sample grid) at which the commanded point is nearest to the circle's angle `angle`
+/// about `center` while on block `block`.
+double time_at_angle(const MotionPlan& plan, std::size_t block, const Point& center, double angle) {
+  double best_t = 0.0, best = 1e9;
+  for (const auto& m : plan.moves()) {
+    if (m.block != block) continue;
+    for (double t = m.t_start; t <= m.t_end; t += plan.ts()) {
+      const Point q = plan.position_at(t);
+      const double gap = std::abs(std::remainder(std::atan2(q[1] - center[1], q[0] - center[0]) - angle, 2.0 * kPi));
+      if (gap < best) {
+        best = gap;
+        best_t = t;
+      }
+    }
+  }
+  return std::round(best_t / plan.ts()) * plan.ts();
+}
+
 TEST(Contour, CircleDistanceIsTheRadialOffsetPositiveInsideACounterClockwiseCircle) {
   ContourProgramOptions o;
   o.center = {5.0, -3.0, 1.0};
@@ -43,12 +61,13 @@ TEST(Contour, CircleDistanceIsTheRadialOffsetPositiveInsideACounterClockwiseCirc
   const MotionPlan plan = plan_motion(program, limits());
   const ContourPath path(program, plan);
   ASSERT_EQ(path.segment_count(), 3u);  // rapid out, circle, rapid back
-  const double t = mid_time(plan, 1);
-  for (int i = 0; i < 24; ++i) {
+  // Angle 0 is where the rapids join the circle: inside points there lie on a rapid (skipped).
+  for (int i = 1; i < 24; ++i) {
     const double angle = 2.0 * kPi * i / 24.0;
+    // Where the command passes that angle: the window (+-0.05 s, +-9 mm of arc) holds that part.
+    const double t = time_at_angle(plan, 1, o.center, angle);
     for (const double rho : {19.0, 19.99, 20.0, 20.5, 23.0}) {
       const Point p{5.0 + rho * std::cos(angle), -3.0 + rho * std::sin(angle), 1.0};
-      // A 0.05 s window keeps the rapids (which run through the circle's inside) out.
       const ContourPoint c = path.nearest(p, t, 0.05);
       EXPECT_NEAR(c.distance, std::abs(rho - 20.0), 1e-12) << angle << " " << rho;
       EXPECT_NEAR(c.signed_distance, 20.0 - rho, 1e-12);
@@ -56,8 +75,42 @@ TEST(Contour, CircleDistanceIsTheRadialOffsetPositiveInsideACounterClockwiseCirc
     }
   }
   // A deviation along the plane normal adds in quadrature.
-  const ContourPoint c = path.nearest({5.0 + 21.0, -3.0, 1.0 + 0.5}, t, 0.05);
+  const ContourPoint c = path.nearest({5.0 + 21.0 * std::cos(0.5), -3.0 + 21.0 * std::sin(0.5), 1.0 + 0.5},
+                                      time_at_angle(plan, 1, o.center, 0.5), 0.05);
   EXPECT_NEAR(c.distance, std::hypot(1.0, 0.5), 1e-12);
+  // Only the part of the circle run within the window counts: the far side is not "near".
+  const double t = time_at_angle(plan, 1, o.center, 0.5 * kPi);
+  const ContourPoint far = path.nearest({5.0, -3.0 - 20.5, 1.0}, t, 0.05);  // beside the circle at -90 deg
+  EXPECT_GT(far.distance, 10.0);
+}
+
+TEST(Contour, SignIsContinuousAcrossTheRapidToArcJoin) {
+  // An axis pair lagging 5 samples behind the command, 20 um down and left: around the rapid -> arc
+  // join the lagging point is still near the rapid's end, below it (right of travel): the signed
+  // error is its y (the distance to the rapid's line, negative). With whole segments in the
+  // window, the circle's last part (arriving at the same point from below) was nearer than the
+  // rapid for some of those samples and the signed error flipped to about +20 um: a 40 um spike.
+  const Program program = make_circle_program({});
+  const MotionPlan plan = plan_motion(program, limits());
+  const ContourPath path(program, plan);
+  const Trajectory c = sample(plan, {Axis::X, Axis::Y});
+  std::vector<std::vector<double>> lagging(2, std::vector<double>(c.size()));
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    const std::size_t j = k >= 5 ? k - 5 : 0;
+    lagging[0][k] = c.positions[0][j] - 0.02;
+    lagging[1][k] = c.positions[1][j] - 0.02;
+  }
+  const std::vector<double> e = contour_errors(path, c.axes, lagging);
+  const double t_join = plan.moves()[0].t_end;
+  std::size_t checked = 0;
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    // While the lagging point is beside the rapid's last millimetre (x in [19, 19.98]), below it.
+    const double x = lagging[0][k];
+    if (static_cast<double>(k) * plan.ts() > t_join + 0.05 || x < 19.0 || x > 19.98 || lagging[1][k] >= 0.0) continue;
+    EXPECT_NEAR(e[k], lagging[1][k], 1e-12) << "sample " << k;
+    ++checked;
+  }
+  EXPECT_GT(checked, 5u);
 }
 
 TEST(Contour, ClockwiseArcIsPositiveOutside) {
@@ -99,19 +152,15 @@ TEST(Contour, DiamondEdgesAndCorners) {
   EXPECT_EQ(path.kind_at(0.5 * plan.moves()[0].t_end), PathKind::Rapid);
 }
 
-/// Brute force: the smallest distance to the continuous path sampled every `dt` over the whole
-/// motion blocks that run within [t - window, t + window] (the documented neighbourhood).
+/// Brute force: the smallest distance to the continuous path sampled every `dt` over
+/// [t - window, t + window] (the documented neighbourhood: the part run within the window).
 double brute_force(const MotionPlan& plan, const Point& p, double t, double window, double dt) {
-  double t0 = plan.duration(), t1 = 0.0;
-  for (const auto& m : plan.moves()) {
-    if (m.type == BlockType::Dwell || m.t_end < t - window || m.t_start > t + window) continue;
-    t0 = std::min(t0, m.t_start);
-    t1 = std::max(t1, m.t_end);
-  }
   double best = std::numeric_limits<double>::infinity();
-  for (double tau = t0; tau <= t1; tau += dt) {
-    const Point q = plan.position_at(tau);
+  const double t1 = std::min(plan.duration(), t + window);
+  for (double tau = std::max(0.0, t - window);; tau += dt) {
+    const Point q = plan.position_at(std::min(tau, t1));
     best = std::min(best, std::hypot(q[0] - p[0], q[1] - p[1], q[2] - p[2]));
+    if (tau >= t1) break;
   }
   return best;
 }
@@ -124,7 +173,7 @@ void check_against_brute_force(const Program& program, std::uint64_t seed, doubl
   const double window = 0.05, dt = 2e-6;
   const double max_speed = 200.0;  // mm/s: bounds the spacing of the brute force's points
   for (int i = 0; i < 30; ++i) {
-    const double t = time(rng);
+    const double t = std::round(time(rng) / plan.ts()) * plan.ts();  // windows end on samples
     Point p = plan.position_at(t);
     for (double& c : p) c += offset(rng);
     const ContourPoint exact = path.nearest(p, t, window);

@@ -102,8 +102,10 @@ Program generate(IdentificationSet set, const std::string& axes, std::size_t mov
 TEST(IdentificationProgram, GoldenProgramsInTheThesisLayout) {
   WriteOptions table32;
   table32.sign_column = true;
-  EXPECT_EQ(write_program(generate(IdentificationSet::Standard, "X", 12, 7, Dialect::Iso), table32),
-            test::read_text(kData + "identification_standard_x_seed7.nc"));
+  // Table 3.2 as printed states no path-control mode; servotwin's default adds G61 (below).
+  Program table = generate(IdentificationSet::Standard, "X", 12, 7, Dialect::Iso);
+  for (Block& b : table.blocks) b.path_control = PathControl::Unstated;
+  EXPECT_EQ(write_program(table, table32), test::read_text(kData + "identification_standard_x_seed7.nc"));
   EXPECT_EQ(write_program(generate(IdentificationSet::Low, "X", 12, 7, Dialect::Heidenhain)),
             test::read_text(kData + "identification_low_x_seed7.h"));
   EXPECT_EQ(write_program(generate(IdentificationSet::High, "XY", 8, 42, Dialect::Heidenhain)),
@@ -125,7 +127,9 @@ TEST(IdentificationProgram, StandardShapeIsoTable32) {
   EXPECT_EQ(p.blocks[201].number, 2010);
   EXPECT_EQ(p.blocks[202].m_codes, std::vector<int>{30});
   const std::string text = write_iso(p);
-  EXPECT_EQ(text.substr(0, text.find('\n')), "N0000 G00 X0.000 F12000");
+  // Table 3.2's first block with the exact-stop mode stated (a controller's default, e.g. LinuxCNC's
+  // blending, must not decide how the identification moves end).
+  EXPECT_EQ(text.substr(0, text.find('\n')), "N0000 G61 G00 X0.000 F12000");
   EXPECT_EQ(std::count(text.begin(), text.end(), 'F'), 1) << "F only on the first block";
 }
 

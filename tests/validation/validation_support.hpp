@@ -21,11 +21,15 @@ namespace servotwin::validation {
 inline constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 /// Capture of a Table 3.2-style X program (200 random moves within +-10 mm at F12000) on a machine.
+/// As printed in the thesis, the program states no path-control mode (servotwin's generator
+/// writes G61 by default): the machine's own rule decides whether consecutive moves in the same
+/// direction run on (the ZPETC preset) or stop (the Fadal presets stop after every block).
 inline vcnc::NamedCapture thesis_capture(const machine::MachineConfig& machine, std::uint64_t seed,
                                          motion::IdentificationSet set = motion::IdentificationSet::Standard) {
   motion::IdentificationOptions o = motion::identification_defaults(set);
   o.axes = {motion::Axis::X};
   o.seed = seed;
+  o.path_control = motion::PathControl::Unstated;
   const motion::Program program = motion::make_identification_program(o);
   return {machine.name + " seed " + std::to_string(seed), vcnc::run_program(machine, program)};
 }

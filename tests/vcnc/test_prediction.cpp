@@ -136,5 +136,115 @@ TEST(Prediction, ModelsAndCapturesThatDoNotFitAreRejected) {
               testing::ThrowsMessage<core::InputError>(HasSubstr("no axis y")));
 }
 
+
+/// A trace whose command is `command` (axes in X, Y order) and whose measured position is the
+/// models' response to it: a machine that IS the models.
+core::Capture trace_of(const std::vector<std::vector<double>>& command, const rapid::ModelCoefficients& c, double ts = 0.001) {
+  core::Capture trace;
+  trace.ts = ts;
+  for (std::size_t i = 0; i < command.size(); ++i) {
+    rapid::ModelSimulationOptions sim;
+    sim.initial_position = command[i].front();
+    trace.axes.push_back({i == 0 ? "x" : "y", command[i], rapid::AxisModel(c, 0.001).simulate(command[i], sim).position, {}});
+  }
+  return trace;
+}
+
+TEST(PredictionFromCommand, TheInterpolatorsOwnCommandGivesTheSamePrediction) {
+  const motion::Program diamond = motion::make_diamond_program({});
+  const Prediction p = predict(diamond, "d.nc", limits(), xy_models(lagging_loop()));
+  const core::Capture trace = trace_of(p.command, lagging_loop());
+  const Prediction q = predict_from_command(trace, "trace.csv", &diamond, "d.nc", xy_models(lagging_loop()));
+  ASSERT_EQ(q.size(), p.size());
+  for (std::size_t i = 0; i < 2; ++i) EXPECT_EQ(q.predicted[i], p.predicted[i]);
+  for (std::size_t k = 0; k < p.size(); ++k) ASSERT_NEAR(q.contour_error[k], p.contour_error[k], 1e-9) << k;
+  const MeasuredComparison m = compare_with_trace(q, trace, "trace.csv");
+  EXPECT_EQ(m.count, p.size());
+  for (const auto& s : m.scores) EXPECT_LE(s.metrics.nrmse, 1e-12) << s.quantity << " " << s.kind;
+  EXPECT_TRUE(q.warnings.empty());
+}
+
+TEST(PredictionFromCommand, AnotherControllersCommandIsFollowedWhereTheCaptureComparisonRefusesIt) {
+  // A controller with half the acceleration that runs through the diamond's corners (G64): its
+  // command is millimetres away from servotwin's interpolation of the program at the same time.
+  motion::ContourProgramOptions o;
+  o.path_control = motion::PathControl::Blend;
+  const motion::Program diamond = motion::make_diamond_program(o);
+  motion::InterpolationLimits other = limits();
+  other.accel = 1000.0;
+  other.corner_angle_deg = 100.0;
+  const motion::Trajectory command = motion::interpolate(diamond, other, {motion::Axis::X, motion::Axis::Y});
+  const core::Capture trace = trace_of(command.positions, lagging_loop());
+  const Prediction ours = predict(diamond, "d.nc", limits(), xy_models(lagging_loop()));
+  EXPECT_THAT([&] { (void)compare_with_capture(ours, trace, "trace.csv"); },
+              testing::ThrowsMessage<core::InputError>(HasSubstr("--command")));
+  EXPECT_FALSE(ours.notes.empty());  // blending: the note that points to the recorded command
+  const Prediction q = predict_from_command(trace, "trace.csv", &diamond, "d.nc", xy_models(lagging_loop()));
+  const MeasuredComparison m = compare_with_trace(q, trace, "trace.csv");
+  for (const auto& s : m.scores) EXPECT_LE(s.metrics.nrmse, 1e-12) << s.quantity << " " << s.kind;
+  // The contour error is measured against the programmed edges: the machine rounds the corners.
+  double largest = 0.0;
+  for (double e : q.contour_error) largest = std::max(largest, std::abs(e));
+  EXPECT_GT(largest, 0.05);
+}
+
+TEST(PredictionFromCommand, WithoutAProgramTheCommandsOwnPathIsTheReference) {
+  const motion::Program circle = motion::make_circle_program({});
+  const Prediction p = predict(circle, "c.nc", limits(), xy_models(lagging_loop()));
+  core::Capture trace = trace_of(p.command, lagging_loop());
+  const Prediction q = predict_from_command(trace, "trace.csv", nullptr, "", xy_models(lagging_loop()));
+  // On the arc, away from its ends, the polyline's chords give the circle's errors to within their
+  // sagitta (v ts)^2 / 8R = (0.186 mm)^2 / 160 mm = 2.2e-4 mm.
+  std::size_t checked = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const double t = static_cast<double>(k) * p.ts;
+    if (p.kind[k] != motion::PathKind::Arc || t < 0.4 || t > 0.8) continue;
+    EXPECT_NEAR(q.contour_error[k], p.contour_error[k], 2.5e-4) << k;
+    EXPECT_EQ(q.kind[k], motion::PathKind::Move);
+    ++checked;
+  }
+  EXPECT_GT(checked, 100u);
+}
+
+TEST(PredictionFromCommand, TracesThatDoNotFitAreRejected) {
+  const auto c = lagging_loop();
+  const motion::Program diamond = motion::make_diamond_program({});
+  const Prediction p = predict(diamond, "d.nc", limits(), xy_models(c));
+  core::Capture trace = trace_of(p.command, c);
+  const auto rejects = [&](const core::Capture& t, const motion::Program* program, const std::vector<AxisModelSpec>& models,
+                           const std::string& text) {
+    EXPECT_THAT([&] { (void)predict_from_command(t, "trace.csv", program, "d.nc", models); },
+                testing::ThrowsMessage<core::InputError>(HasSubstr(text)));
+  };
+  core::Capture slow = trace;
+  slow.ts = 0.002;
+  rejects(slow, &diamond, xy_models(c), "sample period");
+  core::Capture x_only = trace;
+  x_only.axes.pop_back();
+  rejects(x_only, &diamond, xy_models(c), "no commanded position of axis y");
+  rejects(trace, &diamond, {{"x", rapid::AxisModel(c, 0.001), 0, "x.json"}}, "moves but no model");
+  rejects(trace, nullptr, {{"x", rapid::AxisModel(c, 0.001), 0, "x.json"}}, "moves but no model");
+  // A run of another program (the circle) is not a run of the diamond.
+  const Prediction other = predict(motion::make_circle_program({}), "c.nc", limits(), xy_models(c));
+  rejects(trace_of(other.command, c), &diamond, xy_models(c), "leaves");
+  // A trace that stops a third of the way.
+  core::Capture cut = trace;
+  for (auto& a : cut.axes) {
+    a.cmd.resize(a.cmd.size() / 3);
+    a.act.resize(a.act.size() / 3);
+  }
+  rejects(cut, &diamond, xy_models(c), "covers");
+  EXPECT_THAT([&] { (void)compare_with_trace(p, cut, "cut.csv"); }, testing::ThrowsMessage<core::InputError>(HasSubstr("cut.csv")));
+}
+
+TEST(Prediction, AProgramWithoutAStatedModeIsWarnedAbout) {
+  motion::ContourProgramOptions o;
+  o.path_control = motion::PathControl::Unstated;
+  const Prediction p = predict(motion::make_diamond_program(o), "d.nc", limits(), xy_models(lagging_loop()));
+  ASSERT_EQ(p.warnings.size(), 1u);
+  EXPECT_THAT(p.warnings.front(), HasSubstr("states no path-control mode"));
+  EXPECT_TRUE(predict(motion::make_diamond_program({}), "d.nc", limits(), xy_models(lagging_loop())).warnings.empty());
+}
+
 }  // namespace
 }  // namespace servotwin::vcnc

@@ -29,6 +29,8 @@ struct CaptureReadOptions {
   std::optional<double> ts;
   /// Axes to read (lower-case); empty = every axis that has both `_cmd` and `_act`.
   std::vector<std::string> axes;
+  /// Axes may lack `_act` (a commanded trajectory only): AxisTrace::act is then empty.
+  bool allow_missing_actual = false;
 };
 
 /// Reads a capture from a stream, line by line: memory holds only the columns used.

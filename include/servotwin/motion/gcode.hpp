@@ -19,7 +19,9 @@
 ///   the line. Lines starting with `%` are tape marks and ignored.
 /// * G words: G00 G01 G02 G03 (motion), G04 (dwell), G17 G18 G19 (plane), G20 G21 (inch/mm),
 ///   G90 G91 (absolute/incremental), G90.1 G91.1 (arc centre absolute/incremental, default G91.1),
-///   G94 (feed per minute, the only feed mode), G40 (cutter compensation off, accepted as a no-op).
+///   G94 (feed per minute, the only feed mode), G40 (cutter compensation off, accepted as a no-op),
+///   G61 (exact stop mode) and G64 (continuous path mode, no tolerance word), kept per block as
+///   Block::path_control.
 ///   Several G words of different modal groups may share a line; two of the same group are an error.
 ///   A line carries at most one motion (or one dwell).
 /// * Modal state at the start: no motion mode (axis words before the first G00..G03 are an error),
@@ -32,6 +34,12 @@
 /// * G04 takes its time in seconds from `P` or `X` (P in seconds as in LinuxCNC and Siemens, not
 ///   Fanuc's integer milliseconds).
 /// * Feeds: F > 0 per minute, modal. G01/G02/G03 without any feed programmed before is an error.
+///
+/// LinuxCNC dialect: the ISO subset above, but with LinuxCNC's path-control words (LinuxCNC G-code
+/// reference, G61/G61.1/G64): G61 is *exact path* (stops where the direction changes, runs on
+/// through tangent and collinear joins), G61.1 exact stop, `G64 P<p> [Q<q>]` blending within p
+/// (program units; P0 = plain G64), q the naive-CAM tolerance. P and Q belong to G64 there;
+/// in ISO, `G64 P..` and G61.1 are errors that point to `--dialect linuxcnc`.
 ///
 /// Heidenhain dialect, in detail (block numbers at the start of a line are optional):
 /// * `BEGIN PGM name MM|INCH` first, `END PGM name MM|INCH` last (same name and unit); INCH
@@ -48,6 +56,10 @@
 ///   (R+ at most 180 degrees, R- above). A coordinate along the plane normal makes a helix (an
 ///   extension: the TNC itself programs helices with CP).
 /// * `CYCL DEF 9.0 DWELL TIME` followed by `CYCL DEF 9.1 DWELL <seconds>` is a dwell.
+/// * `CYCL DEF 32.0 TOLERANCE` followed by `CYCL DEF 32.1 T<tolerance>` sets PathControl::Blend
+///   with that tolerance (the TNC smooths corners within it); a bare `CYCL DEF 32.1` returns to
+///   the machine's value (PathControl::Unstated). `CYCL DEF 32.2 HSC-MODE:.. TA..` is kept as a
+///   statement, not interpreted. Klartext has no exact-stop word.
 /// * `;` starts a comment. RL/RR radius compensation and other path functions (CT, CP, LP, RND,
 ///   CHF, APPR, DEP, ...) are unsupported: errors, or warnings (word or block ignored) in lenient
 ///   mode.
@@ -77,6 +89,10 @@ struct ParseOptions {
 /// Parses ISO G-code (see the file comment for the exact subset).
 Program parse_iso(std::string_view text, std::string_view source_name, const ParseOptions& options = {});
 
+/// Parses ISO G-code with LinuxCNC's path-control words (see the file comment): G61 is exact
+/// path, G61.1 exact stop, `G64 [P<tolerance> [Q<naive-CAM tolerance>]]` blending.
+Program parse_linuxcnc(std::string_view text, std::string_view source_name, const ParseOptions& options = {});
+
 /// Parses the Heidenhain conversational subset (see the file comment).
 Program parse_heidenhain(std::string_view text, std::string_view source_name,
                          const ParseOptions& options = {});
@@ -85,7 +101,8 @@ Program parse_heidenhain(std::string_view text, std::string_view source_name,
 Program parse_program(std::string_view text, std::string_view source_name,
                       const ParseOptions& options = {}, std::optional<Dialect> dialect = std::nullopt);
 
-/// Guesses the dialect from the text (ignores leading blank, comment and `%` lines).
+/// Guesses the dialect from the text (ignores leading blank, comment and `%` lines): Heidenhain or
+/// ISO (a LinuxCNC program is read as ISO unless the dialect is given).
 Dialect detect_dialect(std::string_view text) noexcept;
 
 /// How the writers print a program.
@@ -109,7 +126,8 @@ struct WriteOptions {
 
 /// Writes a program in ISO G-code: mm, absolute coordinates, arcs by I/J/K (incremental), the
 /// motion G word on every motion line, F when the feed changes, a plane word (G17/G18/G19) when
-/// the plane changes. Blocks keep their stored N numbers (none when Block::number < 0). Heidenhain
+/// the plane changes, the path-control word (G61 / G64) when a stated mode changes (on a line of
+/// its own before a dwell). Blocks keep their stored N numbers (none when Block::number < 0). Heidenhain
 /// statements (BLK FORM, TOOL CALL) are written as comments. None blocks without M codes, comment
 /// and statement are not written. The start position (ParseOptions::start) is not part of the text.
 std::string write_iso(const Program& program, const WriteOptions& options = {});
@@ -118,11 +136,22 @@ std::string write_iso(const Program& program, const WriteOptions& options = {});
 /// numbered consecutively (a comment-only block with Block::number < 0 is written without a
 /// number, as in the thesis tables), R0 on the first block moving in its plane, `F MAX` for rapids, F when the
 /// feed changes, arcs as `CC` (when the centre or plane changes) + `C ... DR+/DR-`, dwells as
-/// cycle 9, `END PGM name MM`. The name is the stem of Program::name with characters other than
+/// cycle 9, Cycle 32 TOLERANCE (`CYCL DEF 32.0 TOLERANCE`, `CYCL DEF 32.1 T<tol>`; a bare 32.1 to
+/// return to the machine's value) when the path-control mode changes, a `;path control: ...`
+/// comment for modes Klartext cannot state, `END PGM name MM`. The name is the stem of Program::name with characters other than
 /// letters, digits, `_` and `-` replaced by `_` ("PGM" when empty).
 std::string write_heidenhain(const Program& program, const WriteOptions& options = {});
 
+/// Writes a program in ISO G-code like write_iso, with LinuxCNC's path-control words: G61.1 for
+/// exact stop, G61 for exact path, `G64 [P<tolerance> [Q<naive-CAM tolerance>]]` for blending.
+std::string write_linuxcnc(const Program& program, const WriteOptions& options = {});
+
 /// Writes a program in its own dialect (Program::dialect).
 std::string write_program(const Program& program, const WriteOptions& options = {});
+
+/// Whether a dialect has words for a path-control mode: ISO G61 and G64 without a tolerance (and
+/// LinuxCNC's exact path only as the stricter G61); LinuxCNC every mode; Heidenhain Klartext only
+/// Cycle 32 TOLERANCE (Blend with a tolerance) and its reset (Unstated).
+bool can_state(Dialect dialect, PathControl mode, double blend_tolerance_mm) noexcept;
 
 }  // namespace servotwin::motion

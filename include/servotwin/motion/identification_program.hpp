@@ -22,14 +22,16 @@
 ///   reverse order, so the random part is balanced in direction.
 ///
 /// Framing by dialect:
-/// * Iso (Table 3.2): `N0000 G00 X0.000 F12000` (the rapid carries the feed), `N0010 G01 ...`,
-///   N numbers in steps of 10, then `M30`.
+/// * Iso (Table 3.2): `N0000 G61 G00 X0.000 F12000` (the rapid carries the feed and the
+///   path-control word, see `path_control`), `N0010 G01 ...`, N numbers in steps of 10, then `M30`.
+///   LinuxCnc is framed the same way.
 /// * Heidenhain (Tables 4.3/4.4): a comment block (unnumbered), `BLK FORM 0.1 Z` / `0.2` spanning
 ///   centre +- range on all three axes, `TOOL CALL 0 Z`, `L <selected X/Y axes> R0 F MAX M3`, then
 ///   `L Z.. F MAX` only if Z is selected, the moves with F on the first, `M30`. Write it with
 ///   write_program (or write_heidenhain) to get `BEGIN PGM name MM` ... `END PGM name MM`.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -55,6 +57,12 @@ struct IdentificationOptions {
   std::string name = "RAPIDIDENT";  ///< program name (Heidenhain BEGIN PGM): letters, digits, _ or -
   int decimals = 3;                 ///< targets are rounded to this many decimals (1 um), 0..9
   Dialect dialect = Dialect::Iso;   ///< framing of the program (see the file comment)
+  /// Path-control mode stated on every block; empty = the dialect's default: exact stop for ISO
+  /// (G61) and LinuxCNC (G61.1), nothing for Heidenhain (the machine's setting; Klartext has no
+  /// exact-stop word). A reversal stops anyway; the mode matters for moves that continue in the
+  /// same direction, and it keeps the controller's default (LinuxCNC blends) from applying.
+  std::optional<PathControl> path_control;
+  double blend_tolerance_mm = 0.0;  ///< with PathControl::Blend: the stated tolerance, 0 = none
 };
 
 /// Defaults of each set as in the thesis: Standard 200 moves, +-10 mm, F12000 (Table 3.2);
@@ -64,7 +72,8 @@ IdentificationOptions identification_defaults(IdentificationSet set);
 /// Builds the program. Throws core::InputError for no axes or a repeated axis, zero moves, range
 /// not finite or below one output step (10^-decimals), feed <= 0 or above 1e9 mm/min, decimals
 /// outside 0..9, a centre that is not finite or (on a selected axis) not on the 10^-decimals grid, targets beyond
-/// +-1e9 mm, or a name that BEGIN PGM cannot carry.
+/// +-1e9 mm, a name that BEGIN PGM cannot carry, or a path-control mode the dialect cannot state
+/// (field "path_control").
 Program make_identification_program(const IdentificationOptions& options);
 
 }  // namespace servotwin::motion

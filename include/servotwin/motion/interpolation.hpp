@@ -28,8 +28,11 @@
 /// of a changing speed on a curve.
 ///
 /// **Junctions.** theta = angle between the end tangent of one segment and the start tangent of
-/// the next. theta > `corner_angle_deg` (and > 1e-9 rad, so numerically tangent joins never stop)
-/// -> exact stop. Otherwise the feed continues through the junction, and the speed there is
+/// the next. The path-control mode of the first block (Block::path_control) decides: ExactStop
+/// (G61) -> exact stop; ExactPath (LinuxCNC G61) -> exact stop unless theta <= 1e-9 rad (tangent
+/// and collinear joins run on); Blend (G64) and Unstated -> exact stop when theta >
+/// `corner_angle_deg` (and > 1e-9 rad, so numerically tangent joins never stop). Blending does not
+/// round corners: a blended corner is passed on the programmed path at a capped speed (below). Otherwise the feed continues through the junction, and the speed there is
 /// limited so that the sampled trajectory still respects the limits when checked by finite
 /// differences: a junction where the velocity vector jumps by v |p'_2 - p'_1| (a shallow corner)
 /// adds up to v |p'_2 - p'_1| / ts to a second difference / ts^2 and v |p'_2 - p'_1| / ts^2 to a
@@ -44,7 +47,8 @@
 /// whose jumps are at rounding level (|p'_2 - p'_1| <= 16 eps, |p''_2 - p''_1| <= 16 eps |p''|:
 /// collinear lines, an arc continuing on the same circle) are smooth: no cap, no zone, and between
 /// equal limits the profile simply continues through them (also in S-curve mode). Program start
-/// and end and dwells are exact stops; `exact_stop_every_block` makes every block end in one.
+/// and end and dwells are exact stops; `exact_stop_every_block` (a controller without look-ahead)
+/// makes every block end in one, whatever the program states.
 /// The bound adds the magnitudes of the jumps (it does not count on their cancelling), so dense
 /// polylines (many chords per window) are planned conservatively: chords of a circle of radius R
 /// run at about sqrt(junction_share accel R / 2) without a jerk limit (half the true circle's
@@ -92,8 +96,8 @@ struct InterpolationLimits {
   double rapid_feed_mm_min = 15000;  ///< feed of rapid moves [mm/min], > 0
   double max_feed_mm_min = 1e9;      ///< cap on programmed feeds [mm/min], > 0
   double corner_angle_deg = 1.0;     ///< exact stop when the direction changes more than this, [0, 180]
-  /// Exact stop at the end of every motion block (ISO G61 exact-stop mode, as simple controllers
-  /// without look-ahead run), instead of continuous feed through shallow and tangent junctions.
+  /// Exact stop at the end of every motion block, whatever mode the program states (a simple
+  /// controller without look-ahead), instead of continuous feed through shallow and tangent junctions.
   bool exact_stop_every_block = false;
   /// On arcs, the share of `accel` (and `jerk`) available along the path; the rest bounds the
   /// centripetal acceleration, so the total stays within `accel`. In (0, 1).

@@ -24,7 +24,19 @@ const char* axis_name(Axis a) noexcept;
 /// Bit of an axis in an axis mask.
 constexpr std::uint8_t axis_bit(Axis a) noexcept { return static_cast<std::uint8_t>(1U << static_cast<unsigned>(a)); }
 
-enum class Dialect { Iso, Heidenhain };
+/// G-code dialect of a program. LinuxCnc is ISO with LinuxCNC's meaning of the path-control words
+/// (G61 exact path, G61.1 exact stop, `G64 P<tol> Q<tol>`); see gcode.hpp and docs/gcode.md.
+enum class Dialect { Iso, LinuxCnc, Heidenhain };
+
+/// How the controller passes from one motion block to the next (ISO modal group 13; Heidenhain
+/// Cycle 32). Which words express each mode depends on the dialect (docs/gcode.md).
+enum class PathControl : std::uint8_t {
+  Unstated,   ///< the program does not say: the controller's own setting applies
+  ExactStop,  ///< stop at the end of every block (ISO/Fanuc G61, LinuxCNC G61.1)
+  ExactPath,  ///< reach every programmed point: stop at corners, keep speed where moves continue
+              ///< tangentially (LinuxCNC G61)
+  Blend       ///< continuous feed, corners blended (G64), within Block::blend_tolerance_mm if > 0
+};
 
 enum class BlockType : std::uint8_t {
   Rapid,   ///< G00 / Heidenhain `F MAX`: straight line at the machine's rapid feed
@@ -59,7 +71,20 @@ struct Block {
   /// None blocks only: a dialect statement without motion, kept for rewriting in canonical form
   /// with lengths in mm (Heidenhain `BLK FORM 0.1 Z X-50.000 Y-50.000 Z-50.000`, `TOOL CALL 0 Z`).
   std::string statement;
+  /// Path-control mode in effect for this block (modal); it governs the junction at the block's
+  /// end, as in LinuxCNC, where a segment's termination is fixed when it is queued.
+  PathControl path_control = PathControl::Unstated;
+  /// Blend only: largest deviation from the programmed corner the controller may take [mm]
+  /// (LinuxCNC `G64 P`, Heidenhain Cycle 32 `T`); 0 = none stated (plain G64).
+  double blend_tolerance_mm = 0.0;
+  /// Blend only, LinuxCNC: naive-CAM tolerance `G64 Q` [mm]; negative = not written (LinuxCNC then
+  /// takes P's value).
+  double cam_tolerance_mm = -1.0;
 };
+
+/// A path-control mode in words for messages, e.g. "exact stop at every block end", "corners
+/// blended within 0.01 mm".
+std::string describe_path_control(PathControl mode, double blend_tolerance_mm);
 
 /// A reader's warning (only in lenient mode), tied to a line and column.
 struct Diagnostic {
@@ -78,6 +103,10 @@ struct Program {
   /// Mask of axes that the program moves (any block whose end differs from its start in that axis)
   /// or writes.
   [[nodiscard]] std::uint8_t used_axes() const noexcept;
+  /// True when some motion block has a stated path-control mode.
+  [[nodiscard]] bool states_path_control() const noexcept;
+  /// True when some motion block blends (PathControl::Blend).
+  [[nodiscard]] bool blends() const noexcept;
 };
 
 }  // namespace servotwin::motion

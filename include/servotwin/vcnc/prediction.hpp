@@ -5,9 +5,17 @@
 /// trajectory, and the tracking errors and the contour error (motion/contour.hpp: the true
 /// distance to the commanded path, positive to the left of travel) come out per sample. A measured
 /// capture of the same program can be aligned in time and scored against the prediction.
+///
+/// A real controller's look-ahead, corner blending, jerk limits and feed override never match
+/// servotwin's interpolator; the thesis (section 4.3.3) drove its models with the captured
+/// command. predict_from_command does that: the commanded trajectory is a trace's `<axis>_cmd`
+/// columns, the contour error is measured against the program's path (the command matched to it
+/// sample by sample) or, without a program, against the command's own path, and the trace's
+/// `<axis>_act` columns are scored beside the prediction.
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,8 +48,12 @@ struct Prediction {
   std::vector<std::vector<double>> predicted;       ///< predicted actual position
   std::vector<double> contour_error;                ///< of the predicted motion [mm], signed
   std::vector<motion::PathKind> kind;               ///< what the commanded point is on at each sample
-  std::shared_ptr<const motion::ContourPath> path;  ///< the commanded path (for measured comparisons)
+  /// The path contour errors are measured against (for measured comparisons and reports).
+  std::shared_ptr<const motion::ContourReference> path;
   double contour_window_s = 0.2;
+  /// What the prediction rests on that a user should know (e.g. a program that states no
+  /// path-control mode); `notes` are facts (e.g. the offset of a trace from the program).
+  std::vector<std::string> warnings, notes;
   [[nodiscard]] std::size_t size() const noexcept { return kind.size(); }
   /// Predicted tracking error command - predicted of axis i at sample k.
   [[nodiscard]] double tracking_error(std::size_t i, std::size_t k) const noexcept {
@@ -51,16 +63,45 @@ struct Prediction {
 
 /// Interpolates `program` with `limits` (its ts is replaced by the models' common period) and
 /// simulates every model whose axis the program moves, each from rest at its start position.
+/// The program's path-control modes are honoured by the planner (motion/interpolation.hpp); a
+/// program that states none gets a warning (the corner rule of `limits` decides, not the
+/// controller's default), one that blends a note (servotwin's planner does not round corners the
+/// controller's way: predict from its recorded command instead).
 /// core::InputError naming the model's source or the program when: no model is given, an axis
 /// name is not x, y or z or appears twice, the models' sample periods differ, or the program
 /// moves an axis without a model.
 Prediction predict(const motion::Program& program, const std::string& program_name, motion::InterpolationLimits limits,
                    const std::vector<AxisModelSpec>& models, const PredictionOptions& options = {});
 
+/// How predict_from_command reads a trace.
+struct CommandPredictionOptions {
+  double contour_window_s = 0.2;  ///< see PredictionOptions
+  /// Largest distance the trace's command may keep from the program's path [mm]; empty = from the
+  /// program's path-control modes: 0.01 mm plus 1e-4 of the motion range for exact stop and exact
+  /// path, the largest stated blend tolerance plus that for blending with a tolerance, and 10 % of
+  /// the motion range where blending has no tolerance or the mode is not stated.
+  std::optional<double> path_tolerance_mm;
+  /// Trace coordinates = program coordinates + offset [mm]; empty = found (motion/contour.hpp).
+  std::optional<motion::Point> offset;
+};
+
+/// Predicts from a controller's recorded command: every model is simulated on the trace's
+/// `<axis>_cmd` column (with its command shift, from rest at the first command). With `program`,
+/// contour errors are measured against its lines and arcs, the trace matched to it in time (the
+/// command's progress along the path) and space (offset); without, against the command's own
+/// path. core::InputError naming the trace or a model's source when: no model is given, a model's
+/// axis is missing from the trace, the models' sample periods differ from each other or from the
+/// trace's, an axis that moves (in the program, or in the trace without one) has no model, the
+/// command leaves the program's path by more than the tolerance (not a run of this program), or
+/// it covers less than half of the program's path.
+Prediction predict_from_command(const core::Capture& trace, const std::string& trace_name, const motion::Program* program,
+                                const std::string& program_name, const std::vector<AxisModelSpec>& models,
+                                const CommandPredictionOptions& options = {});
+
 /// Predicted vs measured scores of one quantity over the samples of one kind of path.
 struct PredictionScore {
   std::string quantity;  ///< "x tracking", "y tracking", ..., "contour"
-  std::string kind;      ///< "all", "line", "arc", "rapid", "stop"
+  std::string kind;      ///< "all", "line", "arc", "rapid", "stop", "move"
   rapid::FitMetrics metrics;
 };
 
@@ -83,5 +124,10 @@ struct MeasuredComparison {
 /// fewer than half of the prediction's samples are covered.
 MeasuredComparison compare_with_capture(const Prediction& prediction, const core::Capture& capture,
                                         const std::string& source);
+
+/// Scores a prediction made by predict_from_command(trace, ...) against the same trace's `<axis>_act`
+/// columns, sample by sample (no alignment: the prediction runs on the trace's own samples).
+/// core::InputError naming `source` when the trace has another length or lacks a predicted axis.
+MeasuredComparison compare_with_trace(const Prediction& prediction, const core::Capture& trace, const std::string& source);
 
 }  // namespace servotwin::vcnc
