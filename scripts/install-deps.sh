@@ -2,8 +2,9 @@
 # Installs the Debian 12 packages servotwin needs that are not installed yet.
 #   scripts/install-deps.sh          build dependencies (compiler, CMake, Eigen, CLI11, fmt, JSON, GLPK, and
 #                                    npm, which fetches the charting library of the HTML reports)
-#   scripts/install-deps.sh --test   plus GoogleTest/GoogleMock, Google Benchmark and Chromium (the
-#                                    reports are checked in headless Chromium)
+#   scripts/install-deps.sh --test   plus GoogleTest/GoogleMock, Google Benchmark, Chromium (the
+#                                    reports are checked in headless Chromium) and LinuxCNC (the
+#                                    integration test runs servotwin's programs on it)
 #   scripts/install-deps.sh --fuzz   plus clang for the libFuzzer targets
 set -euo pipefail
 
@@ -13,7 +14,7 @@ packages=(g++ make cmake libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-de
 command -v npm >/dev/null || packages+=(npm)
 for arg in "$@"; do
   case "$arg" in
-    --test) packages+=(libgtest-dev libgmock-dev libbenchmark-dev python3 chromium) ;;
+    --test) packages+=(libgtest-dev libgmock-dev libbenchmark-dev python3 chromium linuxcnc-uspace) ;;
     --fuzz) packages+=(clang libclang-rt-dev) ;;
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 2 ;;
   esac

@@ -12,6 +12,7 @@
 #include "servotwin/report/identification_report.hpp"
 #include "solver_options.hpp"
 #include "servotwin/core/error.hpp"
+#include "servotwin/vcnc/trace_check.hpp"
 
 namespace servotwin::cli {
 
@@ -27,6 +28,7 @@ struct IdentifyArgs {
   double trim_start_s = 0.0, trim_end_s = 0.0, deadband = 0.0;
   CLI::Option* deadband_opt = nullptr;
   bool refine = false;
+  ProgramSource program;
   std::string output, stats_output, report;
 };
 
@@ -85,6 +87,15 @@ int run(const IdentifyArgs& a, const GlobalOptions& global) {
   const std::vector<vcnc::NamedCapture> validation = read_captures(a.validate, a.reading);
   progress(global, "read {} capture(s){} in {:.1f} ms", captures.size(),
            validation.empty() ? "" : fmt::format(" and {} validation capture(s)", validation.size()), elapsed_ms(start));
+  if (!a.program.path.empty()) {
+    // The identification run checked against its program: units, path, feed override.
+    const motion::Program program = load_program(a.program);
+    for (const auto& c : captures) {
+      const vcnc::TraceCheck check = vcnc::check_trace(c.capture, c.source, &program, a.program.path);
+      for (const auto& w : check.warnings) fmt::print(stderr, "warning: {}\n", w);
+      for (const auto& n : check.notes) progress(global, "{}", n);
+    }
+  }
 
   vcnc::IdentificationSettings settings;
   apply_solver_input(a.solver, settings);
@@ -96,12 +107,16 @@ int run(const IdentifyArgs& a, const GlobalOptions& global) {
   settings.refine = a.refine;
 
   const std::vector<std::string> axes = axes_to_identify(a, captures, global);
+  const io::TraceProfile profile = capture_profile(a.reading);
+  const std::string length_unit = profile.reading.scale == 1.0 ? "as in the file"
+                                  : !profile.units.empty()     ? "mm (file in " + profile.units + ")"
+                                                               : fmt::format("file unit x {}", profile.reading.scale);
   const auto report_file = open_report(a.report, global);
   std::vector<vcnc::AxisIdentification> records;
   records.reserve(axes.size());
   for (const auto& axis : axes) {
     vcnc::AxisIdentification& record = records.emplace_back(vcnc::identify_axis(captures, validation, axis, settings));
-    record.length_unit = a.reading.scale == 1.0 ? "as in the file" : fmt::format("file unit x {}", a.reading.scale);
+    record.length_unit = length_unit;
     print_model_summary(record);
     if (!a.stats_output.empty()) {
       std::vector<std::string> warnings;
@@ -148,6 +163,10 @@ void register_identify(CLI::App& app, Action& selected) {
                "Refine the solver's model by output error: the coefficients whose simulation follows the measured "
                "position best, within the same bounds (slower: some 100 simulations)");
   add_capture_input_options(*cmd, a->reading);
+  cmd->add_option("-p,--program", a->program.path,
+                  "The program the captures ran: checks units, that the command follows its path, and the feed")
+      ->check(CLI::ExistingFile);
+  add_program_reading_options(*cmd, a->program);
   cmd->add_option("--validate", a->validate, "Validation captures: the model's simulated tracking error is scored on them")
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", a->output, "Model file (servotwin.axis-model/1); {axis} in the name for several axes");

@@ -11,6 +11,8 @@
 
 #include "csv_lines.hpp"
 #include "number_format.hpp"
+#include "servotwin/io/linuxcnc_config.hpp"
+#include "trace_table.hpp"
 
 namespace servotwin::io {
 
@@ -30,6 +32,10 @@ class ColumnResolver {
   ColumnResolver(const std::vector<Field>& header, const CaptureReadOptions& options, std::string_view source)
       : options_(options), source_(source) {
     for (const Field& f : header) names_.emplace_back(f.text);
+    if (options.format == TraceFormat::Halscope) {
+      for (const auto& n : names_)
+        if (const auto ours = joint_pin_column(n, options.joint_axes)) aliases_.emplace_back(*ours, n);
+    }
     for (const auto& [ours, theirs] : options.map) {
       if (std::find(names_.begin(), names_.end(), theirs) == names_.end())
         throw core::InputError({std::string(source), 1, 0, "--map " + ours + "=" + theirs},
@@ -40,6 +46,8 @@ class ColumnResolver {
   /// Index of our column `name` in the file, or npos.
   [[nodiscard]] std::size_t find(const std::string& name) const {
     std::string wanted = name;
+    for (const auto& [ours, theirs] : aliases_)
+      if (ours == name) wanted = theirs;
     for (const auto& [ours, theirs] : options_.map)
       if (lower(ours) == name) wanted = theirs;
     std::size_t found = std::string::npos;
@@ -66,6 +74,7 @@ class ColumnResolver {
     std::vector<std::string> ours;
     for (const auto& n : names_) ours.push_back(lower(n));
     for (const auto& [our_name, theirs] : options_.map) ours.push_back(lower(our_name));
+    for (const auto& [our_name, theirs] : aliases_) ours.push_back(our_name);
     std::vector<std::string> axes;
     for (const auto& n : ours) {
       for (std::string_view suffix : {"_cmd", "_act"}) {
@@ -87,6 +96,7 @@ class ColumnResolver {
   const CaptureReadOptions& options_;
   std::string_view source_;
   std::vector<std::string> names_;
+  std::vector<std::pair<std::string, std::string>> aliases_;  ///< our name -> a LinuxCNC joint pin's channel
 };
 
 /// Where each data row came from, stored compactly: rows are consecutive lines except after
@@ -132,6 +142,10 @@ void check_time_grid(const std::vector<double>& t, const RowLines& lines, double
 }
 
 void validate_options(const CaptureReadOptions& options, std::string_view source) {
+  if (options.comment_prefix.empty())
+    throw core::InputError({std::string(source), 0, 0, "comment_prefix"}, "the comment prefix must not be empty");
+  if (options.format == TraceFormat::Csv && (options.delimiter == '"' || options.delimiter == '\n' || options.delimiter == '\0'))
+    throw core::InputError({std::string(source), 0, 0, "delimiter"}, "the delimiter must be a character such as , ; or tab");
   if (!std::isfinite(options.scale) || options.scale == 0.0)
     throw core::InputError({std::string(source), 0, 0, "--scale"}, "scale must be a finite non-zero number");
   if (!(options.max_jitter >= 0.0 && options.max_jitter < 0.5))
@@ -149,19 +163,22 @@ std::pair<std::string, std::string> parse_column_mapping(std::string_view text) 
   return {lower(text.substr(0, eq)), std::string(text.substr(eq + 1))};
 }
 
+const char* trace_format_name(TraceFormat format) noexcept {
+  switch (format) {
+    case TraceFormat::Csv: return "csv";
+    case TraceFormat::Halsampler: return "halsampler";
+    case TraceFormat::Halscope: return "halscope";
+  }
+  return "?";
+}
+
 core::Capture read_capture_csv(std::istream& in, std::string_view source_name, const CaptureReadOptions& options) {
   validate_options(options, source_name);
   const std::string source(source_name);
-  std::string line;
-  std::size_t line_number = 0;
   std::vector<Field> fields;
-
-  // Header: first line that is neither blank nor a comment.
-  line_number = detail::read_header_line(in, source, line, "a header row with column names");
-  const std::size_t header_line = line_number;
-  detail::split_csv_line(line, fields);
-  const std::size_t field_count = fields.size();
-  const ColumnResolver columns(fields, options, source);
+  detail::TraceTable table(in, source, options);
+  const std::size_t header_line = table.header_line();
+  const ColumnResolver columns(table.header(), options, source);
 
   core::Capture capture;
   std::vector<std::string> axes = options.axes;
@@ -177,10 +194,11 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
   std::vector<double> time;
   const std::size_t t_index = columns.find("t");
   if (t_index != std::string::npos) sinks.push_back({t_index, "t", &time, 1.0});
-  else if (!options.ts)
+  else if (!options.ts && !table.period())
     throw core::InputError({source, header_line, 0, "t"},
                            "missing time column 't' (columns: " + columns.column_list() +
-                               "); map one with --map t=<column> or give the sample period with --ts");
+                               "); map one with --map t=<column> or give the sample period with --ts" +
+                               (options.format == TraceFormat::Halsampler ? " or --ini" : ""));
   for (auto& trace : capture.axes) {
     sinks.push_back({columns.require(trace.name + "_cmd"), trace.name + "_cmd", &trace.cmd, options.scale});
     const std::size_t act = options.allow_missing_actual ? columns.find(trace.name + "_act") : columns.require(trace.name + "_act");
@@ -192,7 +210,8 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
   RowLines row_lines;
   std::size_t rows = 0;
   double previous_t = 0.0;
-  while (detail::next_data_row(in, source, line, line_number, fields, field_count)) {
+  while (table.next(fields)) {
+    const std::size_t line_number = table.line_number();
     const core::SourceLocation where{source, line_number, 0, ""};
     for (const ColumnSink& sink : sinks) {
       const double value = detail::parse_number(fields[sink.index], where, sink.name) * sink.scale;
@@ -211,9 +230,9 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
     row_lines.add(rows, line_number);
     ++rows;
   }
-  if (in.bad()) throw core::InputError({source, line_number, 0, ""}, "read error");
+  if (in.bad()) throw core::InputError({source, table.line_number(), 0, ""}, "read error");
   if (rows < 2)
-    throw core::InputError({source, line_number, 0, ""},
+    throw core::InputError({source, table.line_number(), 0, ""},
                            fmt::format("{} data row{}: a capture needs at least 2 samples", rows, rows == 1 ? "" : "s"));
 
   if (!time.empty()) {
@@ -224,7 +243,10 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
                                          capture.ts));
   } else {
     capture.t0 = 0.0;
-    capture.ts = *options.ts;
+    if (options.ts && table.period() && std::abs(*options.ts - *table.period()) > 1e-9 * *table.period())
+      throw core::InputError({source, 0, 0, "--ts"}, fmt::format("--ts {} disagrees with the file's sampling period {} s",
+                                                                 *options.ts, *table.period()));
+    capture.ts = options.ts ? *options.ts : *table.period();
   }
   for (auto& trace : capture.axes) {
     trace.cmd.shrink_to_fit();

@@ -31,11 +31,11 @@ std::string printable(std::string_view text) {
 }
 }  // namespace
 
-void split_csv_line(std::string_view line, std::vector<Field>& fields) {
+void split_csv_line(std::string_view line, std::vector<Field>& fields, char delimiter) {
   fields.clear();
   std::size_t start = 0;
   while (true) {
-    const std::size_t comma = line.find(',', start);
+    const std::size_t comma = line.find(delimiter, start);
     const std::size_t end = comma == std::string_view::npos ? line.size() : comma;
     std::size_t offset = 0;
     std::string_view text = trim(line.substr(start, end - start), offset);
@@ -46,6 +46,18 @@ void split_csv_line(std::string_view line, std::vector<Field>& fields) {
     fields.push_back(Field{text, start + offset + 1});
     if (comma == std::string_view::npos) break;
     start = comma + 1;
+  }
+}
+
+void split_blank_separated(std::string_view line, std::vector<Field>& fields) {
+  fields.clear();
+  std::size_t i = 0;
+  while (true) {
+    while (i < line.size() && is_blank(line[i])) ++i;
+    if (i == line.size()) return;
+    const std::size_t start = i;
+    while (i < line.size() && !is_blank(line[i])) ++i;
+    fields.push_back(Field{line.substr(start, i - start), start + 1});
   }
 }
 
@@ -82,12 +94,10 @@ bool next_data_row(std::istream& in, const std::string& source, std::string& lin
   return false;
 }
 
-bool is_skippable_line(std::string_view line) noexcept {
-  for (char c : line) {
-    if (is_blank(c)) continue;
-    return c == '#';
-  }
-  return true;
+bool is_skippable_line(std::string_view line, std::string_view prefix) noexcept {
+  std::size_t i = 0;
+  while (i < line.size() && is_blank(line[i])) ++i;
+  return i == line.size() || line.substr(i, prefix.size()) == prefix;
 }
 
 double parse_number(const Field& field, core::SourceLocation where, std::string_view column_name) {

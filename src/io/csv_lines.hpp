@@ -18,15 +18,19 @@ struct Field {
   std::size_t column = 0;
 };
 
-/// Splits `line` at commas into `fields` (reused buffer). Surrounding blanks and one pair of
-/// double quotes are removed from each field.
-void split_csv_line(std::string_view line, std::vector<Field>& fields);
+/// Splits `line` at commas (or `delimiter`) into `fields` (reused buffer). Surrounding blanks and
+/// one pair of double quotes are removed from each field.
+void split_csv_line(std::string_view line, std::vector<Field>& fields, char delimiter = ',');
+
+/// Splits `line` at runs of blanks (spaces, tabs) into `fields`; leading and trailing blanks
+/// make no empty fields (halsampler ends every value with a blank).
+void split_blank_separated(std::string_view line, std::vector<Field>& fields);
 
 /// ASCII lower case (column names are matched case-insensitively).
 std::string lower(std::string_view s);
 
-/// True for blank lines and `#` comment lines.
-bool is_skippable_line(std::string_view line) noexcept;
+/// True for blank lines and comment lines (starting with `prefix` after blanks).
+bool is_skippable_line(std::string_view line, std::string_view prefix = "#") noexcept;
 
 /// Reads lines up to the header row (the first line that is neither blank nor a `#` comment),
 /// dropping a UTF-8 byte-order mark on the first line; `on_skipped(line, line_number)` sees each

@@ -23,6 +23,8 @@ namespace detail {
 struct ContourSegment {
   Geometry geo;
   double s_begin = 0.0;  ///< path position of the start [mm]
+  double feed = 0.0;     ///< programmed feed [mm/s]; 0 for rapids
+  std::size_t line = 0;  ///< source line of the block
   double t_start = 0.0, t_end = 0.0;
   PathKind kind = PathKind::Line;
   std::size_t normal_axis = 2;  ///< plane normal: the side of a deviation is seen from +normal
@@ -154,6 +156,8 @@ std::vector<ContourSegment> segments_of(const Program& program, const detail::Pa
     seg.s_begin = s.s_begin;
     const BlockType type = program.blocks[s.block].type;
     seg.kind = type == BlockType::Rapid ? PathKind::Rapid : (type == BlockType::Linear ? PathKind::Line : PathKind::Arc);
+    seg.feed = type == BlockType::Rapid ? 0.0 : program.blocks[s.block].feed_mm_min / 60.0;
+    seg.line = program.blocks[s.block].line;
     seg.normal_axis = normal_axis_of(program.blocks[s.block].plane);
     seg.plain_circle = seg.geo.is_arc && seg.geo.dr == 0.0 && seg.geo.rise == Point{0.0, 0.0, 0.0};
     out.push_back(seg);
@@ -361,8 +365,19 @@ ContourPath ContourPath::from_command(const Program& program, const Trajectory& 
     top = std::max(top, step[k]);
   }
   best.kinds_.resize(n);
-  for (std::size_t k = 0; k < n; ++k)
-    best.kinds_[k] = step[k] <= 1e-4 * top ? PathKind::Stop : best.segments_[segment_at(best.segments_, best.progress_[k])].kind;
+  for (std::size_t k = 0; k < n; ++k) {
+    const ContourSegment& seg = best.segments_[segment_at(best.segments_, best.progress_[k])];
+    best.kinds_[k] = step[k] <= 1e-4 * top ? PathKind::Stop : seg.kind;
+    // Speed over the programmed feed (central difference: 2 ts between the points).
+    if (seg.feed <= 0.0 || k == 0 || k + 1 == n) continue;
+    const double ratio = std::sqrt(step[k]) / (2.0 * command.ts) / seg.feed;
+    if (ratio > best.match_.max_feed_ratio) {
+      best.match_.max_feed_ratio = ratio;
+      best.match_.feed_sample = k;
+      best.match_.feed_line = seg.line;
+      best.match_.feed_mm_min = 60.0 * seg.feed;
+    }
+  }
   // Segment time spans: the samples whose progress lies on them.
   for (ContourSegment& seg : best.segments_) {
     const auto first = std::lower_bound(best.progress_.begin(), best.progress_.end(), seg.s_begin);

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "servotwin/core/error.hpp"
+#include "servotwin/vcnc/trace_check.hpp"
 
 namespace servotwin::vcnc {
 
@@ -118,89 +119,6 @@ Prediction predict(const motion::Program& program, const std::string& program_na
   return out;
 }
 
-namespace {
-
-/// The largest distance a controller's command may keep from the program's path: its rounding,
-/// plus the stated blend tolerance, or 10 % of the motion range where the blending is not bounded.
-double default_path_tolerance(const motion::Program& program, double range) {
-  const double rounding = 0.01 + 1e-4 * range;
-  double blend = 0.0;
-  bool unbounded = !program.states_path_control();
-  for (const motion::Block& b : program.blocks) {
-    if (b.type == motion::BlockType::None || b.type == motion::BlockType::Dwell) continue;
-    if (b.path_control != motion::PathControl::Blend) continue;
-    if (b.blend_tolerance_mm > 0.0) {
-      blend = std::max(blend, b.blend_tolerance_mm);
-    } else {
-      unbounded = true;
-    }
-  }
-  return rounding + (unbounded ? 0.1 * range : blend);
-}
-
-double column_range(const std::vector<double>& v) {
-  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
-  return *hi - *lo;
-}
-
-/// The trace's command of every axis it has (for matching a program).
-motion::Trajectory trace_command(const core::Capture& trace, const std::string& trace_name) {
-  motion::Trajectory t;
-  t.ts = trace.ts;
-  for (std::size_t i = 0; i < motion::kAxisCount; ++i) {
-    const auto axis = static_cast<motion::Axis>(i);
-    const core::AxisTrace* a = trace.find(motion::axis_name(axis));
-    if (a == nullptr) continue;
-    if (a->cmd.size() != trace.size())
-      throw error_at(trace_name, std::string(motion::axis_name(axis)) + "_cmd", "the command column has another length");
-    t.axes.push_back(axis);
-    t.positions.push_back(a->cmd);
-  }
-  return t;
-}
-
-std::shared_ptr<const motion::ContourReference> program_reference(const core::Capture& trace, const std::string& trace_name,
-                                                                  const motion::Program& program,
-                                                                  const std::string& program_name,
-                                                                  const CommandPredictionOptions& options, Prediction& out) {
-  const motion::Trajectory command = trace_command(trace, trace_name);
-  double range = 0.0;
-  for (const auto& column : command.positions) range = std::max(range, column_range(column));
-  motion::CommandMatchOptions match_options;
-  match_options.window_s = options.contour_window_s;
-  match_options.tolerance_mm = options.path_tolerance_mm.value_or(default_path_tolerance(program, range));
-  match_options.offset = options.offset;
-  auto path = std::make_shared<motion::ContourPath>(motion::ContourPath::from_command(program, command, match_options));
-  const motion::CommandMatch& m = path->match();
-  if (m.max_deviation > match_options.tolerance_mm) {
-    throw error_at(trace_name, "",
-                   fmt::format("the trace's commanded path leaves {}'s path by {:.4g} mm at t = {:.4g} s (sample {}), more "
-                               "than the tolerance {:.4g} mm{}: is it a run of this program (same coordinates, or "
-                               "give --offset)?",
-                               program_name, m.max_deviation, trace.time(m.worst_sample), m.worst_sample,
-                               match_options.tolerance_mm, options.path_tolerance_mm ? "" : " (set it with --path-tolerance)"));
-  }
-  if (m.progress_end < 0.5 * m.path_length) {
-    throw error_at(trace_name, "",
-                   fmt::format("the trace's command covers {:.4g} mm of {}'s {:.4g} mm path: is it a run of this program?",
-                               m.progress_end, program_name, m.path_length));
-  }
-  if (m.progress_end < m.path_length - match_options.tolerance_mm) {
-    out.warnings.push_back(fmt::format("the trace ends before {} does: its command covers {:.4g} of {:.4g} mm of the path",
-                                       program_name, m.progress_end, m.path_length));
-  }
-  if (m.offset != motion::Point{0.0, 0.0, 0.0}) {
-    out.notes.push_back(fmt::format("the trace is offset from {}'s coordinates by X {:.6g} Y {:.6g} Z {:.6g} mm", program_name,
-                                    m.offset[0], m.offset[1], m.offset[2]));
-  }
-  out.notes.push_back(fmt::format("the trace's command keeps within {:.3g} mm of {}'s path (RMS {:.3g} mm): contour errors "
-                                  "are measured against the programmed lines and arcs",
-                                  m.max_deviation, program_name, m.rms_deviation));
-  return path;
-}
-
-}  // namespace
-
 Prediction predict_from_command(const core::Capture& trace, const std::string& trace_name, const motion::Program* program,
                                 const std::string& program_name, const std::vector<AxisModelSpec>& models,
                                 const CommandPredictionOptions& options) {
@@ -217,8 +135,9 @@ Prediction predict_from_command(const core::Capture& trace, const std::string& t
   if (program == nullptr) {
     for (const core::AxisTrace& a : trace.axes) {
       const auto axis = axis_of(a.name);
-      const double range = a.cmd.empty() ? 0.0 : column_range(a.cmd);
-      if (axis && range > 1e-9 * (std::abs(a.cmd.front()) + 1.0)) moved = static_cast<std::uint8_t>(moved | motion::axis_bit(*axis));
+      if (!axis || a.cmd.empty()) continue;
+      const auto [lo, hi] = std::minmax_element(a.cmd.begin(), a.cmd.end());
+      if (*hi > *lo) moved = static_cast<std::uint8_t>(moved | motion::axis_bit(*axis));
     }
   }
   Prediction out;
@@ -249,7 +168,15 @@ Prediction predict_from_command(const core::Capture& trace, const std::string& t
     out.predicted[i] = spec.model.simulate(out.command[i], sim).position;
   }
   if (program != nullptr) {
-    out.path = program_reference(trace, trace_name, *program, program_name, options, out);
+    TraceCheckOptions check_options;
+    check_options.contour_window_s = options.contour_window_s;
+    check_options.path_tolerance_mm = options.path_tolerance_mm;
+    check_options.offset = options.offset;
+    TraceCheck check = check_trace(trace, trace_name, program, program_name, check_options);
+    out.warnings.insert(out.warnings.end(), check.warnings.begin(), check.warnings.end());
+    out.notes.insert(out.notes.end(), check.notes.begin(), check.notes.end());
+    out.notes.back() += ": contour errors are measured against the programmed lines and arcs";
+    out.path = std::move(check.path);
   } else {
     motion::Trajectory command;
     command.ts = trace.ts;

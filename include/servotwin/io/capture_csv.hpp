@@ -1,9 +1,26 @@
 #pragma once
 /// \file
-/// Capture CSV files (design.md "capture CSV"): a header row, then one row per sample with `t`
+/// Capture files (design.md "capture CSV"): a header row, then one row per sample with `t`
 /// and, per axis, `<axis>_cmd`, `<axis>_act` and optionally `<axis>_u`. Lines starting with `#`
 /// are comments. Foreign files are read through a column map and a unit scale, e.g. the EMPS
 /// benchmark with `x_cmd=qg, x_act=qm, scale 1000` (m -> mm).
+///
+/// Controller trace formats (TraceFormat), as their sources write them:
+/// * LinuxCNC `halsampler` (src/hal/components/sampler_usr.c, LinuxCNC 2.9): no header; one line
+///   per sample, values separated by blanks (`%f` floats, bits as 0/1, s32/u32 integers), each
+///   followed by a blank; with `-t` the sample number comes first. The names come from
+///   CaptureReadOptions::columns (e.g. from the HAL file, linuxcnc_config.hpp), the period from
+///   CaptureReadOptions::ts. A line with one more value than names carries the sample number: it
+///   must go up by one (modulo 2^32; 2.9 prints it signed, so it may wrap to negative), a jump is
+///   a gap of lost samples and an error naming the line. An `overrun` line before the first sample
+///   (a halsampler started late on its FIFO) is accepted, one between samples is a gap (error).
+///   A last line cut short (no line end: halsampler killed) is left out.
+/// * LinuxCNC `halscope` log ("Save Log", src/hal/utils/scope_files.c, 2.9): `# Sampling period is
+///   <n> ns`, a row of channel names separated by `;`, then `;`-separated values (`%.14f`); no
+///   time column (t = row x period); further `#` lines (newer versions) are comments. Channels
+///   named after a joint's command or feedback pin are read as that axis's `_cmd` / `_act`.
+
+#include <cstdint>
 
 #include <iosfwd>
 #include <optional>
@@ -16,8 +33,30 @@
 
 namespace servotwin::io {
 
-/// How to read a capture CSV.
+/// Layout of a capture file.
+enum class TraceFormat : std::uint8_t {
+  Csv,         ///< header row of names, `delimiter`-separated values
+  Halsampler,  ///< LinuxCNC halsampler output (see the file comment)
+  Halscope     ///< LinuxCNC halscope log file (see the file comment)
+};
+/// "csv", "halsampler", "halscope".
+const char* trace_format_name(TraceFormat format) noexcept;
+
+/// How to read a capture file.
 struct CaptureReadOptions {
+  TraceFormat format = TraceFormat::Csv;
+  /// Names of the columns of a file without a header (halsampler), one per value in file order
+  /// (the sample number of `halsampler -t` not counted): our names (x_cmd, x_act, x_u, ...) or any
+  /// other name (then mapped with `map`, or not read).
+  std::vector<std::string> columns;
+  /// CSV only: the character between values (',' ';' or '\t').
+  char delimiter = ',';
+  /// Lines starting with this (after blanks) are comments; not empty.
+  std::string comment_prefix = "#";
+  /// halscope: the axis letter of each joint, for the channels named after LinuxCNC's joint pins
+  /// (`joint.J.motor-pos-cmd` -> <a>_cmd, `joint.J.motor-pos-fb` -> <a>_act; see
+  /// linuxcnc_config.hpp), used where `map` does not name the column.
+  std::string joint_axes = "XYZ";
   /// Our column name -> the file's column name, e.g. {"x_cmd", "qg"}. Unmapped names are looked
   /// up as themselves.
   std::vector<std::pair<std::string, std::string>> map;
@@ -33,10 +72,13 @@ struct CaptureReadOptions {
   bool allow_missing_actual = false;
 };
 
-/// Reads a capture from a stream, line by line: memory holds only the columns used.
-/// Throws core::InputError naming `source_name`, the line and column for: an empty file, a
+/// Reads a capture from a stream in options.format, line by line: memory holds only the columns
+/// used. Throws core::InputError naming `source_name`, the line and column for: an empty file, a
 /// missing column, a row with the wrong number of fields, text/NaN/inf in a number, a
-/// non-increasing time, jitter above `max_jitter`, fewer than 2 rows.
+/// non-increasing time, jitter above `max_jitter`, fewer than 2 rows; for halsampler files: no
+/// `columns` or no `ts`, fewer values on a line than names (pins), a gap in the sample numbers
+/// or an `overrun` between samples; for halscope logs: no sampling-period line, or a `--ts` that
+/// disagrees with it.
 core::Capture read_capture_csv(std::istream& in, std::string_view source_name,
                                const CaptureReadOptions& options = {});
 

@@ -94,6 +94,12 @@ struct CommandMatch {
   double rms_deviation = 0.0;    ///< RMS over the samples [mm]
   double progress_end = 0.0;     ///< path length the command covered [mm]
   double path_length = 0.0;      ///< length of the programmed path [mm]
+  /// Largest commanded speed over the programmed feed on feed moves (lines, arcs): above 1 the
+  /// controller ran faster than programmed (feed override). 0 without feed moves.
+  double max_feed_ratio = 0.0;
+  std::size_t feed_sample = 0;      ///< where
+  std::size_t feed_line = 0;        ///< source line of that block
+  double feed_mm_min = 0.0;         ///< its programmed feed
 };
 
 /// The commanded path of a program, for contour errors. Immutable; queries are allocation-free.
