@@ -1,5 +1,5 @@
 #pragma once
-// Body of the capture-CSV fuzzer, shared by the libFuzzer target (fuzz_capture_csv.cpp, clang) and
+// Body of the capture-file fuzzer (CSV, halsampler and halscope layouts), shared by the libFuzzer target (fuzz_capture_csv.cpp, clang) and
 // the regression test that replays the corpus under gcc (tests/io/test_capture_csv_fuzz.cpp).
 // Contract checked: any byte sequence either reads into a consistent capture or raises
 // core::InputError; a capture that reads back after writing is identical.
@@ -24,10 +24,15 @@ inline void check_capture(const core::Capture& c) {
 
 inline void capture_csv_one_input(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  io::CaptureReadOptions variants[2];
+  io::CaptureReadOptions variants[4];
   variants[1].map = {{"x_cmd", "qg"}, {"x_act", "qm"}};
   variants[1].scale = 1000.0;
   variants[1].ts = 0.001;
+  // LinuxCNC layouts: halsampler (names given, blank-separated, sample numbers) and halscope logs.
+  variants[2].format = io::TraceFormat::Halsampler;
+  variants[2].columns = {"x_cmd", "x_act", "x_u"};
+  variants[2].ts = 0.001;
+  variants[3].format = io::TraceFormat::Halscope;
   for (const auto& options : variants) {
     std::istringstream in(text);
     core::Capture capture;

@@ -40,6 +40,11 @@ using detail::Geometry;
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+/// Path length around the commanded point, in multiples of the actual point's distance from it,
+/// that a contour error is measured to. The nearest path point lies within twice that distance of
+/// the commanded point (triangle inequality); along a curve the path between them is longer than
+/// the straight line (a half circle: pi/2 times), hence 4.
+constexpr double kPassReach = 4.0;
 
 std::size_t normal_axis_of(Plane plane) noexcept {
   switch (plane) {
@@ -105,8 +110,15 @@ double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi)
   };
   consider(hi);
   const double phi_lo = lo * g.rad_per_s, phi_hi = hi * g.rad_per_s;
-  for (double phi = phi0 + kTwoPi * std::floor((phi_lo - phi0) / kTwoPi) - kTwoPi; phi <= phi_hi + kTwoPi; phi += kTwoPi) {
-    double s = std::clamp(phi, phi_lo, phi_hi) / g.rad_per_s;
+  // Starts: the parameters within half a turn of the part where the polar angle is the query's
+  // (clamped into the part; a start repeated by the clamping is run once).
+  double previous_start = -1.0;
+  for (double phi = phi0 + kTwoPi * std::ceil((phi_lo - std::numbers::pi - phi0) / kTwoPi); phi <= phi_hi + std::numbers::pi;
+       phi += kTwoPi) {
+    const double start = std::clamp(phi, phi_lo, phi_hi);
+    if (start == previous_start) continue;
+    previous_start = start;
+    double s = start / g.rad_per_s;
     for (int it = 0; it < 50; ++it) {
       const Point q = g.position(s), t = g.tangent(s), k = g.curvature(s);
       double gt = 0.0, tt = 0.0, gk = 0.0;
@@ -135,15 +147,23 @@ double nearest_parameter(const ContourSegment& seg, const Point& p, double lo, d
   return nearest_on_curve(seg.geo, p, lo, hi);
 }
 
+/// Moves `q` (an open end of the path, `outward` = +1 at the end, -1 at the start) along the end
+/// tangent `t` to the foot of p's perpendicular when p lies beyond that end.
+void extend_past_end(const Point& t, double outward, const Point& p, Point& q) noexcept {
+  double tt = 0.0, dt = 0.0;
+  for (std::size_t i = 0; i < kAxisCount; ++i) {
+    tt += t[i] * t[i];
+    dt += (p[i] - q[i]) * t[i];
+  }
+  if (!(tt > 0.0) || dt * outward <= 0.0) return;
+  for (std::size_t i = 0; i < kAxisCount; ++i) q[i] += dt / tt * t[i];
+}
+
 /// +1 when d points to the left of the direction t (seen from +normal), else -1.
 double side(const Point& t, const Point& d, std::size_t n) noexcept {
   const std::size_t a = (n + 1) % 3, b = (n + 2) % 3;
   const double cross_normal = t[a] * d[b] - t[b] * d[a];  // (t x d) . e_normal
   return cross_normal < 0.0 ? -1.0 : 1.0;
-}
-
-double side_of(const ContourSegment& seg, double s, const Point& q, const Point& p) noexcept {
-  return side(seg.geo.tangent(s), {p[0] - q[0], p[1] - q[1], p[2] - q[2]}, seg.normal_axis);
 }
 
 /// The program's segments (as the interpolator builds them) with their path positions.
@@ -424,11 +444,29 @@ ContourPoint ContourPath::nearest_in(const Point& p_trace, double s_lo, double s
       best.segment = i;
     }
   }
-  best.distance = std::sqrt(best_d2);
-  best.signed_distance =
-      best.distance == 0.0 ? 0.0 : best.distance * side_of(segments_[best.segment], best_s, best.nearest, p);
+  // Past the path's open ends the path continues along its end tangent: what lies beyond the end
+  // along the path is a positioning error, not a deviation from the contour.
+  const ContourSegment& seg = segments_[best.segment];
+  const bool at_start = best.segment == 0 && best_s <= 0.0;
+  const bool at_end = best.segment + 1 == segments_.size() && best_s >= seg.geo.length;
+  if (at_start || at_end) extend_past_end(seg.geo.tangent(best_s), at_start ? -1.0 : 1.0, p, best.nearest);
+  best.distance = std::sqrt(squared_distance(best.nearest, p));
+  best.signed_distance = best.distance == 0.0 ? 0.0 : best.distance * corner_side(best.segment, best_s, best.nearest, p);
   best.nearest = plus(best.nearest, offset_);
   return best;
+}
+
+double ContourPath::corner_side(std::size_t i, double s, const Point& q, const Point& p) const noexcept {
+  const ContourSegment& seg = segments_[i];
+  Point t = seg.geo.tangent(s);
+  // At a corner the side is seen from the direction halfway between the two segments' tangents,
+  // so that a point past the corner (an overshoot) has the same side for both segments.
+  if (s >= seg.geo.length && i + 1 < segments_.size()) t = plus(t, segments_[i + 1].geo.tangent(0.0));
+  if (s <= 0.0 && i > 0) {
+    const Geometry& before = segments_[i - 1].geo;
+    t = plus(t, before.tangent(before.length));
+  }
+  return side(t, minus(p, q), seg.normal_axis);
 }
 
 ContourPoint ContourPath::nearest(const Point& p, double t, double window) const {
@@ -437,7 +475,17 @@ ContourPoint ContourPath::nearest(const Point& p, double t, double window) const
 }
 
 ContourPoint ContourPath::nearest(std::size_t k, const Point& p) const {
-  return nearest(p, static_cast<double>(k) * ts_, window_s_);
+  if (segments_.empty()) throw core::InputError("the program has no motion: there is no path to measure a contour error to");
+  if (!finite(p)) throw core::InputError("contour error of a non-finite point");
+  const std::size_t kc = std::min(k, progress_.size() - 1);
+  const double t = static_cast<double>(kc) * ts_;
+  // The commanded point's place on the path, and the path within kPassReach times the point's
+  // distance from it (see the file comment: other passes of the path stay out).
+  const double s = progress_[kc];
+  const ContourSegment& seg = segments_[segment_at(segments_, s)];
+  const Point q = plus(seg.geo.position(std::clamp(s - seg.s_begin, 0.0, seg.geo.length)), offset_);
+  const double reach = kPassReach * std::sqrt(squared_distance(p, q));
+  return nearest_in(p, std::max(progress_at(t - window_s_), s - reach), std::min(progress_at(t + window_s_), s + reach));
 }
 
 PathKind ContourPath::kind_at(double t) const noexcept {
@@ -498,6 +546,8 @@ CommandPolyline::CommandPolyline(const Trajectory& command, double window_s) {
   }
   start_ = points_.front();
   window_ = static_cast<std::size_t>(std::llround(window_s / command.ts));
+  arc_.resize(n);
+  for (std::size_t k = 1; k < n; ++k) arc_[k] = arc_[k - 1] + std::sqrt(squared_distance(points_[k], points_[k - 1]));
   block_radius_.resize((n + kBlock - 1) / kBlock);
   for (std::size_t b = 0; b < block_radius_.size(); ++b) {
     const std::size_t first = b * kBlock, last = std::min(n - 1, first + kBlock);
@@ -511,8 +561,14 @@ ContourPoint CommandPolyline::nearest(std::size_t k, const Point& p) const {
   if (!finite(p)) throw core::InputError("contour error of a non-finite point");
   const std::size_t n = points_.size();
   const std::size_t kc = std::min(k, n - 1);
-  const std::size_t lo = kc > window_ ? kc - window_ : 0;
-  const std::size_t hi = std::min(n - 1, kc + std::max<std::size_t>(window_, 1));  // chords [lo, hi)
+  // Chords within the window and within kPassReach times the point's distance from the commanded
+  // sample along the path (as ContourPath).
+  const double pass = kPassReach * std::sqrt(squared_distance(p, points_[kc]));
+  const auto first_near = static_cast<std::size_t>(
+      std::lower_bound(arc_.begin(), arc_.end(), arc_[kc] - pass) - arc_.begin());
+  const auto last_near = static_cast<std::size_t>(std::upper_bound(arc_.begin(), arc_.end(), arc_[kc] + pass) - arc_.begin());
+  const std::size_t lo = std::max(kc > window_ ? kc - window_ : 0, first_near > 0 ? first_near - 1 : 0);
+  const std::size_t hi = std::min({n - 1, kc + std::max<std::size_t>(window_, 1), std::max(last_near, kc + 1)});  // chords [lo, hi)
   double best_d2 = kInfinity;
   std::size_t best_chord = lo;
   double best_u = 0.0;
@@ -540,8 +596,26 @@ ContourPoint CommandPolyline::nearest(std::size_t k, const Point& p) const {
   const Point& b = points_[best_chord + 1];
   for (std::size_t i = 0; i < kAxisCount; ++i) out.nearest[i] = a[i] + best_u * (b[i] - a[i]);
   out.segment = best_chord;
-  out.distance = std::sqrt(best_d2);
-  const Point t{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  // Past the command's first and last sample the path continues along the chord (see ContourPath).
+  const Point chord{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  if (best_chord == 0 && best_u <= 0.0) extend_past_end(chord, -1.0, p, out.nearest);
+  if (best_chord + 2 == n && best_u >= 1.0) extend_past_end(chord, 1.0, p, out.nearest);
+  out.distance = std::sqrt(squared_distance(out.nearest, p));
+  Point t{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  // At a vertex the side is seen from the sum of the two chords' directions (see ContourPath).
+  const double len = std::sqrt(squared_distance(a, b));
+  if (len > 0.0) {
+    for (double& c : t) c /= len;
+    const auto add_chord = [&](std::size_t from) {
+      const Point& u = points_[from];
+      const Point& v = points_[from + 1];
+      const double l = std::sqrt(squared_distance(u, v));
+      if (l > 0.0)
+        for (std::size_t c = 0; c < kAxisCount; ++c) t[c] += (v[c] - u[c]) / l;
+    };
+    if (best_u >= 1.0 && best_chord + 2 < n) add_chord(best_chord + 1);
+    if (best_u <= 0.0 && best_chord > 0) add_chord(best_chord - 1);
+  }
   const Point d{p[0] - out.nearest[0], p[1] - out.nearest[1], p[2] - out.nearest[2]};
   out.signed_distance = out.distance == 0.0 || !has_side_ ? out.distance : out.distance * side(t, d, normal_);
   return out;

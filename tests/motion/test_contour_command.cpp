@@ -184,7 +184,9 @@ TEST(CommandPolyline, PruningFindsTheBruteForceNearestChord) {
       const double ax = c.positions[0][j], ay = c.positions[1][j];
       const double dx = c.positions[0][j + 1] - ax, dy = c.positions[1][j + 1] - ay;
       const double len2 = dx * dx + dy * dy;
-      const double u = len2 > 0.0 ? std::clamp(((p[0] - ax) * dx + (p[1] - ay) * dy) / len2, 0.0, 1.0) : 0.0;
+      // The first and last chords continue past the command's ends (the open-end rule).
+      const double lo = j == 0 ? -1e9 : 0.0, hi = j + 2 == c.size() ? 1e9 : 1.0;
+      const double u = len2 > 0.0 ? std::clamp(((p[0] - ax) * dx + (p[1] - ay) * dy) / len2, lo, hi) : 0.0;
       best = std::min(best, std::hypot(p[0] - ax - u * dx, p[1] - ay - u * dy));
     }
     EXPECT_NEAR(path.nearest(k, p).distance, best, 1e-12) << "sample " << k;
