@@ -9,9 +9,11 @@
 //    success without warnings implies strict success;
 //  * every accepted program is consistent: blocks chain (start = previous end), coordinates
 //    finite and within +-1e9 mm, feeds > 0 on feed moves, arcs close within the tolerance;
-//  * write_iso and write_heidenhain produce text that the strict reader of that dialect accepts,
-//    giving back the same motion (types, end points bit for bit, arc centres to rounding, planes
-//    of arcs, feeds, dwell times) and the same M codes in order.
+//  * write_iso, write_linuxcnc and write_heidenhain produce text that the strict reader of that
+//    dialect accepts, giving back the same motion (types, end points bit for bit, arc centres to
+//    rounding, planes of arcs, feeds, dwell times) and the same M codes in order; through the
+//    LinuxCNC dialect, which can state every mode, an ISO or LinuxCNC program keeps its
+//    path-control modes and tolerances too.
 
 #include <algorithm>
 #include <cmath>
@@ -49,8 +51,7 @@ inline Outcome parse(std::string_view text, Dialect dialect, bool lenient) {
   motion::ParseOptions options;
   options.lenient = lenient;
   try {
-    out.program = dialect == Dialect::Iso ? motion::parse_iso(text, kSource, options)
-                                          : motion::parse_heidenhain(text, kSource, options);
+    out.program = motion::parse_program(text, kSource, options, dialect);
   } catch (const core::InputError& e) {
     out.error = e.what();
     const core::SourceLocation& w = e.where();
@@ -150,12 +151,30 @@ inline std::string compare_motion(const Program& a, const Program& b, std::strin
   return {};
 }
 
+/// Path-control modes and tolerances of the motion blocks equal.
+inline std::string compare_modes(const Program& a, const Program& b, std::string_view what) {
+  std::vector<const Block*> ma, mb;
+  for (const Block& x : a.blocks)
+    if (x.type != BlockType::None && x.type != BlockType::Dwell) ma.push_back(&x);
+  for (const Block& x : b.blocks)
+    if (x.type != BlockType::None && x.type != BlockType::Dwell) mb.push_back(&x);
+  if (ma.size() != mb.size()) return std::string(what) + ": motion block count differs";
+  for (std::size_t i = 0; i < ma.size(); ++i) {
+    if (ma[i]->path_control != mb[i]->path_control || ma[i]->blend_tolerance_mm != mb[i]->blend_tolerance_mm ||
+        ma[i]->cam_tolerance_mm != mb[i]->cam_tolerance_mm)
+      return std::string(what) + ": path control of motion block " + std::to_string(i) + " differs";
+  }
+  return {};
+}
+
 inline std::string check_round_trips(const Program& p, std::string_view what) {
-  for (const Dialect out : {Dialect::Iso, Dialect::Heidenhain}) {
-    const char* name = out == Dialect::Iso ? "write_iso" : "write_heidenhain";
+  for (const Dialect out : {Dialect::Iso, Dialect::LinuxCnc, Dialect::Heidenhain}) {
+    const char* name = out == Dialect::Iso ? "write_iso" : out == Dialect::LinuxCnc ? "write_linuxcnc" : "write_heidenhain";
     std::string text;
     try {
-      text = out == Dialect::Iso ? motion::write_iso(p) : motion::write_heidenhain(p);
+      Program written = p;
+      written.dialect = out;
+      text = motion::write_program(written);
     } catch (const std::exception& e) {
       return std::string(what) + ": " + name + " threw: " + e.what();
     }
@@ -164,6 +183,8 @@ inline std::string check_round_trips(const Program& p, std::string_view what) {
       return std::string(what) + ": " + name + " output rejected by the strict reader: " + back.error + back.failure +
              "\n--- written text ---\n" + text;
     std::string problem = compare_motion(p, *back.program, std::string(what) + " via " + name);
+    if (problem.empty() && out == Dialect::LinuxCnc && p.dialect != Dialect::Heidenhain)
+      problem = compare_modes(p, *back.program, std::string(what) + " via " + name);
     if (!problem.empty()) return problem + "\n--- written text ---\n" + text;
   }
   return {};
@@ -176,8 +197,8 @@ inline std::optional<std::string> check_gcode_input(const std::uint8_t* data, st
   using namespace gcode_detail;
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   (void)motion::detect_dialect(text);
-  for (const Dialect dialect : {Dialect::Iso, Dialect::Heidenhain}) {
-    const std::string name = dialect == Dialect::Iso ? "iso" : "heidenhain";
+  for (const Dialect dialect : {Dialect::Iso, Dialect::LinuxCnc, Dialect::Heidenhain}) {
+    const std::string name = dialect == Dialect::Iso ? "iso" : dialect == Dialect::LinuxCnc ? "linuxcnc" : "heidenhain";
     const Outcome strict = parse(text, dialect, false);
     const Outcome lenient = parse(text, dialect, true);
     if (!strict.failure.empty()) return name + " strict: " + strict.failure;

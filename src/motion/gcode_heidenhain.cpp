@@ -81,9 +81,8 @@ class HeidenhainReader {
     while (lines.next(line)) read_line(line, lines.line_number());
     const std::size_t last = lines.line_number() == 0 ? 1 : lines.line_number();
     if (!begun_) report_.error(last, 1, "no 'BEGIN PGM name MM' found: not a Heidenhain conversational program");
-    if (dwell_pending_) report_.error(dwell_line_, 1, "CYCL DEF 9.0 must be followed by CYCL DEF 9.1 DWELL <seconds>");
-    if (tolerance_pending_)
-      report_.error(tolerance_line_, 1, "CYCL DEF 32.0 TOLERANCE must be followed by CYCL DEF 32.1 [T<tolerance>]");
+    no_pending_dwell();
+    no_pending_tolerance();
     if (!ended_) report_.unsupported(last, 1, "missing 'END PGM " + program_.name + (inch_ ? " INCH'" : " MM'") + " at the end");
   }
 
@@ -110,6 +109,14 @@ class HeidenhainReader {
   std::string_view line_;
 
   [[nodiscard]] double unit() const noexcept { return inch_ ? detail::kMmPerInch : 1.0; }
+  /// A two-line cycle (9 DWELL TIME, 32 TOLERANCE) must be finished before anything else.
+  void no_pending_dwell() const {
+    if (dwell_pending_) report_.error(dwell_line_, 1, "CYCL DEF 9.0 must be followed by CYCL DEF 9.1 DWELL <seconds>");
+  }
+  void no_pending_tolerance() const {
+    if (tolerance_pending_)
+      report_.error(tolerance_line_, 1, "CYCL DEF 32.0 TOLERANCE must be followed by CYCL DEF 32.1 [T<tolerance>]");
+  }
   [[noreturn]] void fail(std::size_t column, const std::string& message) const { report_.error(line_no_, column, message); }
   std::string word_at(std::size_t column) const { return detail::word_text(line_, column - 1); }
 
@@ -147,10 +154,10 @@ class HeidenhainReader {
     }
     if (!begun_ && !equals_upper(kw, "BEGIN"))
       fail(kw_column, "expected 'BEGIN PGM name MM' as the first block, found '" + detail::printable(kw) + "'");
-    if (dwell_pending_ && !equals_upper(kw, "CYCL"))
-      report_.error(dwell_line_, 1, "CYCL DEF 9.0 must be followed by CYCL DEF 9.1 DWELL <seconds>");
-    if (tolerance_pending_ && !equals_upper(kw, "CYCL"))
-      report_.error(tolerance_line_, 1, "CYCL DEF 32.0 TOLERANCE must be followed by CYCL DEF 32.1 [T<tolerance>]");
+    if (!equals_upper(kw, "CYCL")) {
+      no_pending_dwell();
+      no_pending_tolerance();
+    }
     if (equals_upper(kw, "BEGIN")) {
       read_begin(c, kw_column);
     } else if (equals_upper(kw, "END")) {
@@ -611,7 +618,7 @@ class HeidenhainReader {
     const std::size_t number_col = c.column();
     const std::string cycle = read_dotted(c);
     if (cycle == "9.0") {
-      if (dwell_pending_) report_.error(dwell_line_, 1, "CYCL DEF 9.0 must be followed by CYCL DEF 9.1 DWELL <seconds>");
+      no_pending_dwell();
       c.skip_blanks();
       if (!c.at_end() && c.peek() != ';') {
         expect_word(c, "DWELL", "CYCL DEF 9.0");
@@ -635,13 +642,12 @@ class HeidenhainReader {
       program_.blocks.push_back(std::move(block));
       return;
     }
-    if (dwell_pending_) report_.error(dwell_line_, 1, "CYCL DEF 9.0 must be followed by CYCL DEF 9.1 DWELL <seconds>");
+    no_pending_dwell();
     if (cycle == "32.0" || cycle == "32.1" || cycle == "32.2") {
       read_tolerance_cycle(c, block, cycle, kw_column);
       return;
     }
-    if (tolerance_pending_)
-      report_.error(tolerance_line_, 1, "CYCL DEF 32.0 TOLERANCE must be followed by CYCL DEF 32.1 [T<tolerance>]");
+    no_pending_tolerance();
     report_.unsupported(line_no_, number_col,
                         "cycle '" + word_at(number_col) + "' is not supported (only cycle 9 DWELL TIME and 32 TOLERANCE)");
   }
@@ -652,8 +658,7 @@ class HeidenhainReader {
   /// `CYCL DEF 32.2 HSC-MODE:<0|1> [TA<angle>]` (machine filter settings: kept, not interpreted).
   void read_tolerance_cycle(Cursor& c, Block& block, const std::string& cycle, std::size_t kw_column) {
     if (cycle == "32.0") {
-      if (tolerance_pending_)
-        report_.error(tolerance_line_, 1, "CYCL DEF 32.0 TOLERANCE must be followed by CYCL DEF 32.1 [T<tolerance>]");
+      no_pending_tolerance();
       expect_word(c, "TOLERANCE", "CYCL DEF 32.0");
       expect_end(c, nullptr, "CYCL DEF 32.0 TOLERANCE");
       tolerance_pending_ = true;
@@ -680,8 +685,7 @@ class HeidenhainReader {
       tolerance_mm_ = t;
       return;
     }
-    if (tolerance_pending_)
-      report_.error(tolerance_line_, 1, "CYCL DEF 32.0 TOLERANCE must be followed by CYCL DEF 32.1 [T<tolerance>]");
+    no_pending_tolerance();
     std::string_view rest = line_.substr(c.pos);
     const std::size_t semicolon = rest.find(';');
     if (semicolon != std::string_view::npos) {

@@ -131,7 +131,8 @@ class IsoWriter {
       case PathControl::Blend: break;
     }
     std::string words = "G64";
-    if (!linuxcnc_ || !(b.blend_tolerance_mm > 0.0)) return words;
+    // Q needs a P before it, even P0 (= no blend tolerance).
+    if (!linuxcnc_ || (!(b.blend_tolerance_mm > 0.0) && b.cam_tolerance_mm < 0.0)) return words;
     words += " P";
     append_number(words, b.blend_tolerance_mm, o_.decimals, '\0');
     if (b.cam_tolerance_mm < 0.0) return words;

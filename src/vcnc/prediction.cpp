@@ -48,6 +48,19 @@ std::array<const AxisModelSpec*, motion::kAxisCount> models_by_axis(const std::v
   return by_axis;
 }
 
+/// Every axis model driven by its commanded column (with its command shift), from rest at the
+/// first command.
+void simulate_models(const std::array<const AxisModelSpec*, motion::kAxisCount>& by_axis, Prediction& out) {
+  out.predicted.resize(out.axes.size());
+  for (std::size_t i = 0; i < out.axes.size(); ++i) {
+    const AxisModelSpec& spec = *by_axis[static_cast<std::size_t>(out.axes[i])];
+    rapid::ModelSimulationOptions sim;
+    sim.command_shift = spec.command_shift;
+    sim.initial_position = out.command[i].front();
+    out.predicted[i] = spec.model.simulate(out.command[i], sim).position;
+  }
+}
+
 std::vector<motion::PathKind> kinds_of(const motion::ContourReference& path, std::size_t n) {
   std::vector<motion::PathKind> kind(n);
   for (std::size_t k = 0; k < n; ++k) kind[k] = path.kind(k);
@@ -103,14 +116,7 @@ Prediction predict(const motion::Program& program, const std::string& program_na
   const motion::Trajectory trajectory = motion::sample(plan, axes);
   out.axes = trajectory.axes;
   out.command = trajectory.positions;
-  out.predicted.resize(out.axes.size());
-  for (std::size_t i = 0; i < out.axes.size(); ++i) {
-    const AxisModelSpec& spec = *by_axis[static_cast<std::size_t>(out.axes[i])];
-    rapid::ModelSimulationOptions sim;
-    sim.command_shift = spec.command_shift;
-    sim.initial_position = out.command[i].front();
-    out.predicted[i] = spec.model.simulate(out.command[i], sim).position;
-  }
+  simulate_models(by_axis, out);
   auto path = std::make_shared<motion::ContourPath>(program, plan, options.contour_window_s);
   out.contour_error = motion::contour_errors(*path, out.axes, out.predicted);
   out.kind = kinds_of(*path, trajectory.size());
@@ -159,14 +165,7 @@ Prediction predict_from_command(const core::Capture& trace, const std::string& t
     out.axes.push_back(axis);
     out.command.push_back(a->cmd);
   }
-  out.predicted.resize(out.axes.size());
-  for (std::size_t i = 0; i < out.axes.size(); ++i) {
-    const AxisModelSpec& spec = *by_axis[static_cast<std::size_t>(out.axes[i])];
-    rapid::ModelSimulationOptions sim;
-    sim.command_shift = spec.command_shift;
-    sim.initial_position = out.command[i].front();
-    out.predicted[i] = spec.model.simulate(out.command[i], sim).position;
-  }
+  simulate_models(by_axis, out);
   if (program != nullptr) {
     TraceCheckOptions check_options;
     check_options.contour_window_s = options.contour_window_s;

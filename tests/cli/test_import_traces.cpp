@@ -46,29 +46,22 @@ TEST_F(ImportTraces, HalsamplerNamedByTheHalFileAndTimedByTheIni) {
 }
 
 TEST_F(ImportTraces, BadReadingOptionsNameTheOptionOrTheLine) {
-  // Fewer names than pins... and more: the file has 9 pins and a sample number.
-  auto r = run("import " + kRigTrace + " --format halsampler --columns x_cmd,x_act,x_u,y_cmd,y_act,y_u,z_cmd,z_act,z_u,extra --ts 0.001");
-  EXPECT_EQ(r.status, 3);
-  EXPECT_THAT(r.err, HasSubstr("first column counts 1 by 1"));
-  r = run("import " + kRigTrace + " --format halsampler --columns x_cmd,x_act,x_u,y_cmd,y_act,y_u,z_cmd,z_act,z_u,a,b --ts 0.001");
-  EXPECT_EQ(r.status, 3);
-  EXPECT_THAT(r.err, HasSubstr("fewer columns than pins"));
-  r = run("import " + kRigTrace + " --format halsampler --ts 0.001");
-  EXPECT_EQ(r.status, 3);
-  EXPECT_THAT(r.err, HasSubstr("--columns"));
-  r = run("import " + kRigTrace + kLinuxCnc + " --columns x_cmd");
-  EXPECT_EQ(r.status, 3);
-  EXPECT_THAT(r.err, HasSubstr("--columns or --hal, not both"));
-  r = run("import " + kRigTrace + kLinuxCnc + " --ts 0.002");
-  EXPECT_EQ(r.status, 3);
-  EXPECT_THAT(r.err, HasSubstr("disagrees"));
   write("bad.json", R"({"format": "servotwin.trace-profile/1", "units": "yards"})");
-  r = run("import " + kRigTrace + " --profile bad.json");
-  EXPECT_EQ(r.status, 3);
-  EXPECT_THAT(r.err, HasSubstr("bad.json"));
-  r = run("import " + kRigTrace + kLinuxCnc + " --delimiter ab");
-  EXPECT_EQ(r.status, 3);
-  EXPECT_THAT(r.err, HasSubstr("--delimiter"));
+  const std::string halsampler = " --format halsampler --ts 0.001 --columns x_cmd,x_act,x_u,y_cmd,y_act,y_u,z_cmd,z_act,z_u";
+  // The file has 9 pins and a sample number: one name too many, two too many, none.
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {halsampler + ",extra", "first column counts 1 by 1"},
+      {halsampler + ",a,b", "fewer columns than pins"},
+      {" --format halsampler --ts 0.001", "--columns"},
+      {kLinuxCnc + " --columns x_cmd", "--columns or --hal, not both"},
+      {kLinuxCnc + " --ts 0.002", "disagrees"},
+      {" --profile bad.json", "bad.json"},
+      {kLinuxCnc + " --delimiter ab", "--delimiter"}};
+  for (const auto& [options, message] : cases) {
+    const auto r = run("import " + kRigTrace + options);
+    EXPECT_EQ(r.status, 3) << options;
+    EXPECT_THAT(r.err, HasSubstr(message)) << options;
+  }
 }
 
 TEST_F(ImportTraces, ATraceIsCheckedAgainstTheProgramItRan) {
