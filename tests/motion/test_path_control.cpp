@@ -161,7 +161,8 @@ MotionPlan plan_in(const std::string& mode) {
 
 TEST(PathControl, PlannerStopsWhereTheModeSays) {
   // Exact stop: every block ends at rest.
-  for (const auto& m : plan_in("G61.1").moves()) EXPECT_EQ(m.v_end, 0.0);
+  const MotionPlan stop = plan_in("G61.1");
+  for (const auto& m : stop.moves()) EXPECT_EQ(m.v_end, 0.0);
   // Exact path: the collinear join and the 0.5 deg corner... the corner stops, the collinear join runs on.
   const MotionPlan path = plan_in("G61");
   EXPECT_GT(path.moves()[0].v_end, 50.0);
@@ -175,8 +176,8 @@ TEST(PathControl, PlannerStopsWhereTheModeSays) {
   // A controller without look-ahead stops everywhere whatever the program says.
   InterpolationLimits simple;
   simple.exact_stop_every_block = true;
-  for (const auto& m : plan_motion(parse_linuxcnc("G64 G01 X10 F6000\nX20\n", "s.ngc"), simple).moves())
-    EXPECT_EQ(m.v_end, 0.0);
+  const MotionPlan no_look_ahead = plan_motion(parse_linuxcnc("G64 G01 X10 F6000\nX20\n", "s.ngc"), simple);
+  for (const auto& m : no_look_ahead.moves()) EXPECT_EQ(m.v_end, 0.0);
 }
 
 }  // namespace
