@@ -13,13 +13,18 @@ for arg in "$@"; do
 done
 scripts/install-deps.sh --test
 
+started=$SECONDS
+# Minutes and seconds since the start, for the stage lines (CI's budget is 50 minutes).
+elapsed() { printf '%d:%02d' $(((SECONDS - started) / 60)) $(((SECONDS - started) % 60)); }
+
 run_preset() {
   local preset=$1
-  echo "== configure and build ($preset)"
+  echo "== configure and build ($preset), at $(elapsed)"
   cmake --preset "$preset" -DSERVOTWIN_BUILD_TESTS=ON >/dev/null
   cmake --build --preset "$preset"
-  echo "== test ($preset)"
+  echo "== test ($preset), at $(elapsed)"
   ctest --preset "$preset" 2>&1 | tee "build/$preset/ctest.log" | grep -vE "^ +Start|^ *[0-9]+/[0-9]+ Test +#[0-9]+: .* Passed" || true
+  echo "== $preset done at $(elapsed)"
   # ctest's summary (the lines after the per-test list) decides the exit status.
   grep -q "100% tests passed" "build/$preset/ctest.log"
 }

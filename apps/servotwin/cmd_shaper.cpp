@@ -6,10 +6,12 @@
 #include "command.hpp"
 #include "shaper_apply.hpp"
 #include "shaper_compare.hpp"
+#include "shaper_export.hpp"
 #include "shaper_multimode.hpp"
 #include "shaper_select.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/shaper_json.hpp"
+#include "servotwin/shaping/discretization.hpp"
 #include "servotwin/shaping/families.hpp"
 #include "servotwin/shaping/sensitivity.hpp"
 #include "servotwin/shaping/smoothing.hpp"
@@ -32,8 +34,11 @@ struct DesignArgs {
   double accel = 5000.0;
   double scv = 5.0;
   bool json = false;
+  std::string method = "exact";
+  ShaperExport exported;
   std::string output;
   CLI::Option* p_options[4] = {};
+  CLI::Option* method_option = nullptr;
   CLI::Option* v_tol_option = nullptr;
   CLI::Option* ts_option = nullptr;
 };
@@ -79,7 +84,24 @@ int run_design(const DesignArgs& a, const GlobalOptions& global) {
         type == shaping::ShaperType::kThreeHumpEi)
       extras.parameters = {{"v_tol", a.v_tol}};
   }
-  if (a.ts_option->count() > 0) extras.ts = a.ts;
+  if (a.method_option->count() > 0 && a.ts_option->count() == 0)
+    throw core::InputError(core::at_field("--method"), "applies to a discrete shaper: give the sample period with --ts");
+  if (a.json && a.exported.requested())
+    throw core::InputError(core::at_field("--export"), "give either --json or --export, not both");
+  if (a.ts_option->count() > 0) {
+    // The discrete shaper on the sample grid (exact vector decomposition or rounding): what a
+    // drive running at ts executes, and what `shaper apply` then uses as it is.
+    const shaping::DiscretizationMethod method =
+        a.method == "round" ? shaping::DiscretizationMethod::Round : shaping::DiscretizationMethod::Exact;
+    const shaping::DiscreteShaper discrete = shaping::discretize(shaper, a.ts, method);
+    io::DiscreteForm form;
+    form.samples = discrete.delays;
+    form.discretization = shaping::discretization_method_name(method);
+    form.continuous = shaper;
+    extras.discrete = form;
+    extras.ts = a.ts;
+    shaper = discrete.to_shaper();
+  }
   if (!(a.level > 0.0 && a.level < 1.0))
     throw core::InputError(core::at_field("--level"), fmt::format("expected a vibration level in (0, 1), got {}", a.level));
   nlohmann::json robustness = {{"band_level", a.level}};
@@ -101,9 +123,12 @@ int run_design(const DesignArgs& a, const GlobalOptions& global) {
   std::string text;
   if (a.json) {
     text = document.dump(2) + "\n";
+  } else if (a.exported.requested()) {
+    text = a.exported.text(shaper);
   } else {
-    text = fmt::format("{} shaper for {} Hz, zeta {}: {} impulses, duration {:.6g} s\n", shaper.type, a.freq_hz, a.zeta,
-                       shaper.times.size(), shaper.duration());
+    text = fmt::format("{} shaper for {} Hz, zeta {}: {} impulses, duration {:.6g} s{}\n", shaper.type, a.freq_hz, a.zeta,
+                       shaper.times.size(), shaper.duration(),
+                       extras.discrete ? fmt::format(" (discrete at ts = {} s, {})", a.ts, extras.discrete->discretization) : "");
     text += "  t [s]            A\n";
     for (std::size_t i = 0; i < shaper.times.size(); ++i)
       text += fmt::format("  {:<16.9g} {:.9f}\n", shaper.times[i], shaper.amplitudes[i]);
@@ -120,11 +145,12 @@ int run_design(const DesignArgs& a, const GlobalOptions& global) {
   if (a.output.empty()) {
     fmt::print("{}", text);
   } else {
+    // -o writes the JSON, or the firmware text with --export.
     auto out = open_output(a.output, global);
-    out->stream() << (a.json ? text : document.dump(2) + "\n");
+    out->stream() << (a.json || a.exported.requested() ? text : document.dump(2) + "\n");
     out->commit();
     progress(global, "wrote {} shaper to {}", shaper.type, a.output);
-    if (!a.json) fmt::print("{}", text);
+    if (!a.json && !a.exported.requested()) fmt::print("{}", text);
   }
   return kSuccess;
 }
@@ -144,7 +170,14 @@ void add_design(CLI::App& shaper, Action& selected) {
   for (const auto& preset : shaping::zv4_presets()) presets += (presets.empty() ? "" : "|") + preset.name;
   args->p_options[3] = design->add_option("--preset", args->preset, "zv4: a row of Table 6.1: " + presets);
   args->v_tol_option = design->add_option("--v-tol", args->v_tol, "EI family: vibration tolerance (default 0.05)");
-  args->ts_option = design->add_option("--ts", args->ts, "Sample period the shaper will run at [s] (checks Nyquist)");
+  args->ts_option = design->add_option(
+      "--ts", args->ts,
+      "Sample period the shaper will run at [s]: writes the discrete shaper, impulses on the grid (checks Nyquist)");
+  args->method_option = design->add_option("--method", args->method,
+                                           "With --ts: exact (vector decomposition: zero residual kept) or round")
+                            ->check(CLI::IsMember({"exact", "round"}))
+                            ->capture_default_str();
+  args->exported.add_to(*design);
   design->add_option("--level", args->level, "Vibration level of the insensitivity band (default 0.05)");
   design->add_option("--accel", args->accel, "Acceleration for the smoothing measure (default 5000, mm/s^2)");
   design->add_option("--scv", args->scv, "Square-corner velocity for the smoothing measure (default 5, mm/s)");
@@ -153,7 +186,10 @@ void add_design(CLI::App& shaper, Action& selected) {
   set_examples(*design,
                "  servotwin shaper design --type zv4 --freq-hz 4.22 --zeta 0.0079 --p1 0.3 --p2 0.5 --ts 0.001 --json\n"
                "  servotwin shaper design --type mzv --freq-hz 50 --zeta 0.1\n"
-               "  servotwin shaper design --type zv4 --preset 2hei5 --freq-hz 12 --zeta 0.02 -o shaper.json");
+               "  servotwin shaper design --type zv4 --preset 2hei5 --freq-hz 12 --zeta 0.02 -o shaper.json\n"
+               "  servotwin shaper design --type mzv --freq-hz 42 --zeta 0.1 --export klipper --export-axis y\n"
+               "  servotwin shaper design --type zv4 --preset 2hei5 --freq-hz 42 --zeta 0.05 --export rrf\n"
+               "  servotwin shaper design --type zvd --freq-hz 30 --zeta 0.05 --ts 0.000125 -o zvd_8k.json");
   design->callback([args, &selected] { selected = [args](const GlobalOptions& g) { return run_design(*args, g); }; });
 }
 

@@ -20,6 +20,7 @@
 #include "servotwin/io/shaper_json.hpp"
 #include "servotwin/io/signal_csv.hpp"
 #include "servotwin/shaping/discretization.hpp"
+#include "servotwin/shaping/sensitivity.hpp"
 #include "servotwin/shaping/shaped_path.hpp"
 
 namespace servotwin::cli {
@@ -32,6 +33,7 @@ struct ApplyArgs {
   std::string output = "-";
   std::optional<double> ts;
   std::string method = "exact";
+  CLI::Option* method_option = nullptr;
 };
 
 struct CommandColumns {
@@ -74,10 +76,37 @@ shaping::DiscretizationMethod parse_method(const std::string& text) {
   throw core::InputError(core::at_field("--method"), "expected exact or round, got '" + text + "'");
 }
 
+/// The shaper on the trajectory's grid: a discrete shaper as it is (after checking it was made for
+/// this sample period), a continuous one discretized.
+shaping::DiscreteShaper discrete_at(const io::LoadedShaper& loaded, const std::string& path, double ts,
+                                    shaping::DiscretizationMethod method) {
+  if (!loaded.extras.discrete) return shaping::discretize(loaded.shaper, ts, method);
+  const double designed = *loaded.extras.ts;
+  if (std::abs(designed - ts) > 1e-9 * ts)
+    throw core::InputError(core::SourceLocation{path, 0, 0, "ts"},
+                           fmt::format("the shaper is discrete at ts = {} s but the trajectory's period is {} s: design it "
+                                       "for {} s (shaper design --ts {}) or use the continuous shaper",
+                                       designed, ts, ts, ts));
+  shaping::DiscreteShaper d;
+  d.type = loaded.shaper.type;
+  d.omega = loaded.shaper.omega;
+  d.zeta = loaded.shaper.zeta;
+  d.ts = ts;
+  d.delays = loaded.extras.discrete->samples;
+  d.amplitudes = loaded.shaper.amplitudes;
+  d.residual = shaping::residual_vibration(loaded.shaper, loaded.shaper.omega, loaded.shaper.zeta);
+  d.min_amplitude = *std::min_element(d.amplitudes.begin(), d.amplitudes.end());
+  return d;
+}
+
 int run_apply(const ApplyArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   const shaping::DiscretizationMethod method = parse_method(a.method);
   const io::LoadedShaper loaded = io::load_shaper(a.shaper_path);
+  if (loaded.extras.discrete && a.method_option->count() > 0)
+    throw core::InputError(core::at_field("--method"), a.shaper_path + " is a discrete shaper already (" +
+                                                           loaded.extras.discrete->discretization +
+                                                           "): --method applies to continuous shapers");
   io::SignalReadOptions options;
   if (a.ts) {
     if (!std::isfinite(*a.ts) || *a.ts <= 0.0)
@@ -87,7 +116,7 @@ int run_apply(const ApplyArgs& a, const GlobalOptions& global) {
   const io::SignalTable table = read_trajectory(a.trajectory_path, options, a.ts);
   const CommandColumns commanded = command_columns(table);
 
-  const shaping::DiscreteShaper discrete = shaping::discretize(loaded.shaper, table.ts, method);
+  const shaping::DiscreteShaper discrete = discrete_at(loaded, a.shaper_path, table.ts, method);
   const shaping::Columns shaped = shaping::shape_columns(commanded.positions, discrete);
   const shaping::PathDeviation deviation = shaping::path_deviation(commanded.positions, shaped, discrete.max_delay());
 
@@ -101,12 +130,15 @@ int run_apply(const ApplyArgs& a, const GlobalOptions& global) {
   for (std::size_t i = 0; i < commanded.axes.size(); ++i)
     where += fmt::format("{}{} = {:.6g}", i ? ", " : "", commanded.axes[i], deviation.max_point[i]);
   fmt::print(summary,
-             "shaper {} ({:.6g} Hz, zeta {:.6g}): {} pulses at ts = {} s ({} discretization), residual vibration "
+             "shaper {} ({:.6g} Hz, zeta {:.6g}): {} pulses at ts = {} s ({}), residual vibration "
              "{:.3g} %\n"
              "delay added: {:.6g} s ({} samples)\n"
              "contour distortion: rms {:.6g}, max {:.6g} at t = {:.6g} s ({})\n",
              loaded.shaper.type, loaded.shaper.omega / (2.0 * std::numbers::pi), loaded.shaper.zeta,
-             discrete.delays.size(), table.ts, shaping::discretization_method_name(method), 100.0 * discrete.residual,
+             discrete.delays.size(), table.ts,
+             loaded.extras.discrete ? loaded.extras.discrete->discretization + " discretization, as designed"
+                                    : std::string(shaping::discretization_method_name(method)) + " discretization",
+             100.0 * discrete.residual,
              discrete.duration(), discrete.max_delay(), deviation.rms, deviation.max,
              table.t0 + static_cast<double>(deviation.max_index) * table.ts, where);
   if (discrete.min_amplitude < 0.0)
@@ -131,7 +163,7 @@ void add_apply(CLI::App& shaper, Action& selected) {
                   "Output CSV (t, <axis>_cmd, <axis>_shaped, deviation), - for standard output")
       ->capture_default_str();
   cmd->add_option("--ts", a->ts, "Sample period [s] (checked against the time column; needed without one)");
-  cmd->add_option("--method", a->method, "Discretization: exact (vector decomposition) or round")
+  a->method_option = cmd->add_option("--method", a->method, "Discretization of a continuous shaper: exact (vector decomposition) or round")
       ->capture_default_str();
   set_examples(*cmd,
                "  servotwin shaper apply shaper.json trajectory.csv -o shaped.csv\n"

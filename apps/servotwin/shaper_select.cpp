@@ -17,7 +17,9 @@
 #include "servotwin/io/klipper_csv.hpp"
 #include "servotwin/io/plant_model_json.hpp"
 #include "servotwin/io/shaper_json.hpp"
+#include "servotwin/shaping/firmware.hpp"
 #include "servotwin/shaping/selection.hpp"
+#include "shaper_export.hpp"
 
 namespace servotwin::cli {
 
@@ -34,7 +36,9 @@ struct SelectArgs {
   double scv = 5.0;
   double freq_uncertainty = 0.05;
   bool no_multi_mode = false;
+  bool any_shaper = false;
   bool json = false;
+  ShaperExport exported;
   std::string output;
 };
 
@@ -53,6 +57,13 @@ std::vector<shaping::ShaperType> parse_families(const std::string& list) {
     start = comma + 1;
   }
   if (out.empty()) throw core::InputError(core::at_field("--families"), "expected a comma-separated list of families");
+  return out;
+}
+
+/// Klipper's types among servotwin's families: what a Klipper printer can run.
+std::vector<shaping::ShaperType> klipper_families() {
+  std::vector<shaping::ShaperType> out;
+  for (const std::string& name : shaping::klipper_shaper_types()) out.push_back(shaping::parse_shaper_type(name));
   return out;
 }
 
@@ -113,15 +124,29 @@ int run_select(const SelectArgs& a, const GlobalOptions& global) {
     shaping::Spectrum spectrum = io::load_klipper_csv(a.input);
     shaping::SpectrumSelectionOptions o;
     o.axis = shaping::parse_spectrum_axis(a.axis, "--axis");
-    if (!a.families.empty()) o.families = parse_families(a.families);
     o.max_smoothing = a.max_smoothing;
     if (a.max_delay_ms) o.max_delay_s = *a.max_delay_ms * 1e-3;
     o.accel = a.accel;
     o.scv = a.scv;
+    // A Klipper spectrum comes from a Klipper printer: by default the shapers it can run.
+    shaping::SpectrumSelectionOptions klipper = o;
+    klipper.families = klipper_families();
+    klipper.multi_mode = false;
+    if (!a.families.empty()) o.families = parse_families(a.families);
     o.multi_mode = !a.no_multi_mode;
-    sel = shaping::select_shaper_from_spectrum(spectrum, o);
-    what = fmt::format("Shapers fitted to {} (psd_{}, {}; designed for ζ = 0.1):", a.input, a.axis,
-                       spectrum.normalized ? "already normalized" : "normalized by (f + 0.1)");
+    const bool klipper_only = !a.any_shaper && a.families.empty();
+    sel = shaping::select_shaper_from_spectrum(spectrum, klipper_only ? klipper : o);
+    what = fmt::format("Shapers fitted to {} (psd_{}, {}; designed for ζ = 0.1{}):", a.input, a.axis,
+                       spectrum.normalized ? "already normalized" : "normalized by (f + 0.1)",
+                       klipper_only ? "; Klipper's types, --any-shaper for ZVDD, ZV4 and two-mode shapers" : "");
+    if (!klipper_only && !shaping::klipper_has(sel.recommended.shaper.type)) {
+      const shaping::ShaperSelection k = shaping::select_shaper_from_spectrum(spectrum, klipper);
+      sel.reasons.push_back(fmt::format(
+          "against the best shaper Klipper can run, {} @ {} Hz: remaining vibrations {:.1f} % -> {:.1f} %, smoothing "
+          "{:.3f} -> {:.3f}",
+          k.recommended.name, freq_text(k.recommended), 100.0 * k.recommended.vibrations, 100.0 * sel.recommended.vibrations,
+          k.recommended.smoothing, sel.recommended.smoothing));
+    }
   }
 
   io::ShaperFileExtras extras;
@@ -137,11 +162,14 @@ int run_select(const SelectArgs& a, const GlobalOptions& global) {
 
   const std::string text = table_text(sel, model, what);
   const std::string json_text = document.dump(2) + "\n";
+  if (a.json && a.exported.requested())
+    throw core::InputError(core::at_field("--export"), "give either --json or --export, not both");
+  const std::string file_text = a.exported.requested() ? a.exported.text(sel.recommended.shaper) : json_text;
   if (a.output.empty()) {
-    fmt::print("{}", a.json ? json_text : text);
+    fmt::print("{}", a.json || a.exported.requested() ? file_text : text);
   } else {
     auto out = open_output(a.output, global);
-    out->stream() << json_text;
+    out->stream() << file_text;
     out->commit();
     progress(global, "wrote {} shaper to {}", sel.recommended.name, a.output);
     if (!a.json) fmt::print("{}", text);
@@ -162,18 +190,25 @@ void add_select(CLI::App& shaper, Action& selected) {
                      "Limit on Klipper's smoothing at --accel/--scv (default: suggested max_accel >= 1500)");
   select->add_option("--max-delay-ms", args->max_delay_ms, "Limit on the shaper duration [ms]");
   select->add_option("--axis", args->axis, "PSD column of a CSV: x, y, z or xyz (default xyz, as Klipper)");
-  select->add_option("--families", args->families, "Comma-separated families to consider (default: all)");
+  select->add_option("--families", args->families,
+                     "Comma-separated families to consider (default: Klipper's types for a CSV, all for a plant model)");
   select->add_option("--accel", args->accel, "Acceleration of the smoothing measure (default 5000, mm/s^2)");
   select->add_option("--scv", args->scv, "Square-corner velocity of the smoothing measure (default 5, mm/s)");
   select->add_option("--freq-uncertainty", args->freq_uncertainty,
                      "Plant model: relative frequency band each mode must be covered over (default 0.05)");
   select->add_flag("--no-multi-mode", args->no_multi_mode, "CSV: do not consider two-mode (convolved) shapers");
+  select->add_flag("--any-shaper", args->any_shaper,
+                   "CSV: consider every family and two-mode shapers, not only Klipper's types (the gain over the "
+                   "Klipper pick is printed)");
+  args->exported.add_to(*select);
   select->add_flag("--json", args->json, "Print the recommended shaper as servotwin.shaper/1 JSON");
   select->add_option("-o,--output", args->output, "Write the shaper JSON to this file ('-' = stdout)");
   set_examples(*select,
                "  servotwin shaper select resonances_x_20221231_212825.csv\n"
                "  servotwin shaper select resonances_y.csv --max-smoothing 0.1 --json -o shaper_y.json\n"
-               "  servotwin shaper select plant_model.json --max-delay-ms 30");
+               "  servotwin shaper select plant_model.json --max-delay-ms 30\n"
+               "  servotwin shaper select resonances_x.csv --export klipper\n"
+               "  servotwin shaper select resonances_x.csv --any-shaper --export rrf");
   select->callback([args, &selected] { selected = [args](const GlobalOptions& g) { return run_select(*args, g); }; });
 }
 

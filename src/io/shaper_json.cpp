@@ -30,6 +30,38 @@ std::vector<double> finite_array(const JsonObject& o, std::string_view key) {
   return values;
 }
 
+/// The grid of a discrete shaper: samples consistent with times_s and ts.
+DiscreteForm parse_discrete(const JsonObject& o, const shaping::Shaper& s, std::optional<double> ts) {
+  if (!ts) o.fail("ts", "a discrete shaper needs the sample period it was discretized for");
+  DiscreteForm d;
+  const json& samples = o.array("samples");
+  if (samples.size() != s.times.size())
+    o.fail("samples", "expected " + std::to_string(s.times.size()) + " sample indices (one per impulse), got " +
+                          std::to_string(samples.size()));
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (!samples[i].is_number_unsigned()) o.fail("samples", "expected non-negative whole numbers, element " + std::to_string(i) + " is " + samples[i].dump());
+    const auto k = samples[i].get<std::size_t>();
+    if (std::abs(static_cast<double>(k) * *ts - s.times[i]) > 1e-9 * *ts + 1e-15 * s.times[i])
+      o.fail("samples", "sample " + std::to_string(k) + " is not times_s[" + std::to_string(i) + "] / ts = " +
+                            json(s.times[i] / *ts).dump());
+    d.samples.push_back(k);
+  }
+  d.discretization = o.string_or("discretization", "exact");
+  if (d.discretization != "exact" && d.discretization != "round")
+    o.fail("discretization", "expected exact or round, got '" + d.discretization + "'");
+  if (const auto c = o.optional_object("continuous")) {
+    c->allow_only({"times_s", "amplitudes"});
+    d.continuous.type = s.type;
+    d.continuous.omega = s.omega;
+    d.continuous.zeta = s.zeta;
+    d.continuous.times = finite_array(*c, "times_s");
+    d.continuous.amplitudes = finite_array(*c, "amplitudes");
+    if (d.continuous.times.size() != d.continuous.amplitudes.size())
+      c->fail("amplitudes", "expected one amplitude per time");
+  }
+  return d;
+}
+
 }  // namespace
 
 json shaper_to_json(const shaping::Shaper& shaper, const ShaperFileExtras& extras) {
@@ -45,6 +77,12 @@ json shaper_to_json(const shaping::Shaper& shaper, const ShaperFileExtras& extra
   if (!extras.parameters.empty()) j["parameters"] = extras.parameters;
   if (extras.ts) j["ts"] = *extras.ts;
   if (!extras.robustness.empty()) j["robustness"] = extras.robustness;
+  if (extras.discrete) {
+    j["discrete"] = true;
+    j["samples"] = extras.discrete->samples;
+    j["discretization"] = extras.discrete->discretization;
+    j["continuous"] = {{"times_s", extras.discrete->continuous.times}, {"amplitudes", extras.discrete->continuous.amplitudes}};
+  }
   return j;
 }
 
@@ -53,7 +91,8 @@ LoadedShaper parse_shaper_json(std::string_view text, std::string_view source_na
   check_format(document, kShaperFormat, source_name);
   const JsonObject o(document, "", source_name);
   o.allow_only({"format", "type", "freq_hz", "zeta", "times_s", "amplitudes", "duration_s", "residual_at_design",
-                "parameters", "ts", "robustness", "alternatives", "reasons"});
+                "parameters", "ts", "robustness", "alternatives", "reasons", "discrete", "samples", "discretization",
+                "continuous"});
   LoadedShaper loaded;
   shaping::Shaper& s = loaded.shaper;
   s.type = o.string("type");
@@ -90,6 +129,7 @@ LoadedShaper parse_shaper_json(std::string_view text, std::string_view source_na
     (void)o.object("robustness");
     loaded.extras.robustness = document.at("robustness");
   }
+  if (o.boolean_or("discrete", false)) loaded.extras.discrete = parse_discrete(o, s, loaded.extras.ts);
   return loaded;
 }
 

@@ -3,6 +3,7 @@
 // 0.051), the E10 table plant's resonance (ωn = 3 rad/s, ζ = 0.15: catalog E10) for the
 // plant-model route, and io::load_shaper for the round trip of the JSON output.
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numbers>
 
@@ -32,6 +33,24 @@ TEST_F(Cli, SelectFromKlipperSpectrumRecommendsMzvLikeKlipper) {
   const auto document = nlohmann::json::parse(slurp(path("pick.json")));
   EXPECT_TRUE(document.contains("alternatives"));
   EXPECT_TRUE(document.contains("reasons"));
+}
+
+TEST_F(Cli, SelectFromKlipperSpectraRecommendsWhatKlipperCanRun) {
+  // Every real spectrum of data/: by default a Klipper type, exported as Klipper's section;
+  // with --any-shaper the gain over that pick is printed when the best is not Klipper's.
+  std::size_t gains = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(std::string(SERVOTWIN_REPO_DATA_DIR))) {
+    const std::string file = entry.path().string();
+    if (entry.path().extension() != ".csv" || file.find("klipper-") == std::string::npos) continue;
+    SCOPED_TRACE(file);
+    const Result r = run("shaper select '" + file + "' --export klipper");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("[input_shaper]\nshaper_type_x: "), std::string::npos) << r.out;
+    const Result any = run("shaper select '" + file + "' --any-shaper");
+    ASSERT_EQ(any.status, 0) << any.err;
+    gains += any.out.find("against the best shaper Klipper can run") != std::string::npos;
+  }
+  EXPECT_GE(gains, 1u);
 }
 
 TEST_F(Cli, SelectFromFittedPlantModelCancelsItsResonance) {

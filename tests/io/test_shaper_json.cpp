@@ -48,6 +48,34 @@ TEST(ShaperJson, RoundTripsTheGantryCraneShaper) {
   EXPECT_EQ(*back.extras.ts, 0.001);
 }
 
+TEST(ShaperJson, DiscreteShapersKeepTheirGridAndDesign) {
+  // A discrete shaper's file: samples consistent with times_s / ts, the continuous design beside.
+  nlohmann::json j = good();
+  j["times_s"] = {0.0, 0.003};
+  j["ts"] = 0.001;
+  j["discrete"] = true;
+  j["samples"] = {0, 3};
+  j["discretization"] = "round";
+  j["continuous"] = {{"times_s", {0.0, 0.0031}}, {"amplitudes", {0.5, 0.5}}};
+  const LoadedShaper loaded = parse_shaper_json(j.dump(), "d.json");
+  ASSERT_TRUE(loaded.extras.discrete.has_value());
+  EXPECT_EQ(loaded.extras.discrete->samples, (std::vector<std::size_t>{0, 3}));
+  EXPECT_EQ(loaded.extras.discrete->discretization, "round");
+  EXPECT_EQ(loaded.extras.discrete->continuous.times[1], 0.0031);
+  const nlohmann::json back = shaper_to_json(loaded.shaper, loaded.extras);
+  EXPECT_EQ(back.at("samples"), j.at("samples"));
+  EXPECT_EQ(back.at("continuous"), j.at("continuous"));
+  nlohmann::json off = j;
+  off["samples"] = {0, 2};
+  EXPECT_NE(error_of(off.dump()).find("(samples)"), std::string::npos) << error_of(off.dump());
+  nlohmann::json no_ts = j;
+  no_ts.erase("ts");
+  EXPECT_NE(error_of(no_ts.dump()).find("(ts)"), std::string::npos);
+  nlohmann::json method = j;
+  method["discretization"] = "nearest";
+  EXPECT_NE(error_of(method.dump()).find("(discretization)"), std::string::npos);
+}
+
 TEST(ShaperJson, RejectsBadDocumentsNamingTheField) {
   EXPECT_EQ(error_of(good().dump()), "no error");
   auto with = [](const char* key, nlohmann::json value) {
