@@ -14,8 +14,11 @@
 #include <vector>
 
 #include "command.hpp"
+#include "frf_excitation.hpp"
 #include "servotwin/core/error.hpp"
+#include "servotwin/frf/excitation_recording.hpp"
 #include "servotwin/frf/offline.hpp"
+#include "servotwin/io/excitation_csv.hpp"
 #include "servotwin/io/frf_csv.hpp"
 #include "servotwin/io/plant_json.hpp"
 #include "servotwin/io/signal_csv.hpp"
@@ -28,7 +31,9 @@ namespace {
 
 struct EstimateArgs {
   std::string data;
-  std::string input, output;
+  std::string input, response;
+  std::string retired_output;  // the old name of --response, refused with a pointer to it
+  std::string excitation;      // the design the drive played (frf excitation)
   std::string method = "h1";
   std::string file_out;
   std::string time_column;
@@ -40,7 +45,8 @@ struct EstimateArgs {
   std::string window = "hann";
   double fmin = 0.0, fmax = std::numeric_limits<double>::infinity();
   // multisine
-  std::size_t periods = 0, period = 0, skip_periods = 0;
+  std::size_t periods = 0, period = 0;
+  std::optional<std::size_t> skip_periods;
   std::optional<double> threshold_db;
   std::string detrend = "auto";
 };
@@ -55,7 +61,7 @@ frf::Detrend detrend_of(const std::string& text, frf::Detrend fallback) {
 /// Estimator errors name an option or a signal; say which file and column they concern.
 [[noreturn]] void rethrow_located(const core::InputError& e, const EstimateArgs& a) {
   const std::string& field = e.where().field;
-  std::string where = field == "input" ? a.input : field == "output" ? a.output : "--" + field;
+  std::string where = field == "input" ? a.input : field == "output" ? a.response : "--" + field;
   throw core::InputError({a.data, 0, 0, where}, e.reason());
 }
 
@@ -64,11 +70,23 @@ struct Estimated {
   std::vector<std::string> comments;
 };
 
+/// The period of a periodic input when neither --periods nor --period was given.
+std::size_t detected_period(const std::vector<double>& x, const GlobalOptions& global) {
+  const frf::PeriodDetection d = frf::detect_period(x);
+  if (d.period_samples == 0)
+    throw core::InputError(core::at_field("period"),
+                           "no period found in the input (its autocorrelation stays below 0.8 at every lag up to half "
+                           "the record); give --periods or --period, or use --method h1");
+  progress(global, "multisine: detected a period of {} samples (autocorrelation {:.4f})", d.period_samples,
+           d.correlation);
+  return d.period_samples;
+}
+
 Estimated estimate(const EstimateArgs& a, const io::SignalTable& table, const GlobalOptions& global) {
   const std::vector<double>& x = table.column(a.input);
-  const std::vector<double>& y = table.column(a.output);
+  const std::vector<double>& y = table.column(a.response);
   Estimated out;
-  out.comments.push_back("source: " + a.data + ", input: " + a.input + ", output: " + a.output);
+  out.comments.push_back("source: " + a.data + ", input: " + a.input + ", output: " + a.response);
   try {
     if (a.method == "h1") {
       frf::WelchOptions o;
@@ -90,7 +108,8 @@ Estimated estimate(const EstimateArgs& a, const io::SignalTable& table, const Gl
       frf::MultisineOptions o;
       o.periods = a.periods;
       o.period_samples = a.period;
-      o.skip_periods = a.skip_periods;
+      o.skip_periods = a.skip_periods.value_or(0);
+      if (o.periods == 0 && o.period_samples == 0) o.period_samples = detected_period(x, global);
       o.detrend = detrend_of(a.detrend, frf::Detrend::kLinear);
       o.excitation_threshold_db = a.threshold_db;
       frf::MultisineEstimate e = frf::estimate_multisine(x, y, table.ts, o);
@@ -108,20 +127,53 @@ Estimated estimate(const EstimateArgs& a, const io::SignalTable& table, const Gl
   return out;
 }
 
+/// --excitation: align the recording with the played design and estimate as its type allows.
+Estimated estimate_recorded(const EstimateArgs& a, const io::SignalTable& table, const GlobalOptions& global) {
+  const frf::Excitation excitation = io::read_excitation_file(a.excitation);
+  if (std::abs(excitation.ts - table.ts) > 1e-6 * excitation.ts)
+    throw core::InputError({a.data, 0, 0, "--excitation"},
+                           fmt::format("sampled every {} s, but {} was designed for {} s: record at the period the "
+                                       "drive played it",
+                                       table.ts, a.excitation, excitation.ts));
+  frf::RecordedOptions options;
+  options.skip_periods = a.skip_periods.value_or(1);
+  frf::RecordedEstimate r;
+  try {
+    r = frf::estimate_recorded(excitation, table.column(a.input), table.column(a.response), options);
+  } catch (const core::InputError& e) {
+    rethrow_located(e, a);
+  }
+  const frf::Alignment& al = r.alignment;
+  progress(global, "{} found at sample {} (t = {} s), gain {:.4g}, correlation {:.4f}",
+           frf::excitation_type_name(excitation.type), al.offset, static_cast<double>(al.offset) * table.ts + table.t0,
+           al.gain, al.correlation);
+  progress(global, "{}", r.method);
+  Estimated out;
+  out.comments.push_back("source: " + a.data + ", input: " + a.input + ", output: " + a.response);
+  out.comments.push_back(fmt::format("excitation: {} ({}), found at sample {}, gain {:.6g}, correlation {:.6f}",
+                                     a.excitation, frf::excitation_type_name(excitation.type), al.offset, al.gain,
+                                     al.correlation));
+  out.comments.push_back("method: " + r.method);
+  out.response = std::move(r.response);
+  return out;
+}
+
 void print_summary(const core::FrequencyResponse& r) {
   std::vector<double> quality;
   for (const auto& p : r.points) quality.push_back(p.quality);
   std::sort(quality.begin(), quality.end());
-  fmt::print("frf: {} points, {} ... {} Hz, coherence median {:.4f}, min {:.4f}, duration {} s\n", r.size(),
-             r.points.front().freq_hz, r.points.back().freq_hz, quality[quality.size() / 2], quality.front(),
-             r.duration_s.value_or(0.0));
+  // Coherence: the worst is the lowest; THD: the highest.
+  const bool thd = r.quality_kind == core::QualityKind::kThd;
+  fmt::print("frf: {} points, {} ... {} Hz, {} median {:.4f}, {} {:.4f}, duration {} s\n", r.size(),
+             r.points.front().freq_hz, r.points.back().freq_hz, thd ? "THD" : "coherence", quality[quality.size() / 2],
+             thd ? "max" : "min", thd ? quality.back() : quality.front(), r.duration_s.value_or(0.0));
 }
 
 int run_estimate(const EstimateArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   io::SignalReadOptions reading;
   reading.columns = {a.input};
-  if (a.output != a.input) reading.columns.push_back(a.output);
+  if (a.response != a.input) reading.columns.push_back(a.response);
   reading.time_column = a.time_column;
   reading.fs = a.fs;
   reading.max_jitter = a.max_jitter;
@@ -130,7 +182,7 @@ int run_estimate(const EstimateArgs& a, const GlobalOptions& global) {
   progress(global, "read {}: {} samples at {} Hz{} in {:.1f} ms", a.data, table.size(), 1.0 / table.ts,
            table.time_column.empty() ? " (--fs)" : " (from " + table.time_column + ")", elapsed_ms(start));
 
-  const Estimated estimated = estimate(a, table, global);
+  const Estimated estimated = a.excitation.empty() ? estimate(a, table, global) : estimate_recorded(a, table, global);
   auto out = open_output(a.file_out, global);
   io::write_frf_csv(out->stream(), estimated.response, estimated.comments);
   out->commit();
@@ -148,7 +200,16 @@ void add_estimate(CLI::App& frf, Action& selected) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--input", a->input, "Column of the excitation (input)")->required();
-  cmd->add_option("--output", a->output, "Column of the response (output)")->required();
+  cmd->add_option("--response", a->response, "Column of the response (output)")->required();
+  cmd->add_option("--output", a->retired_output, "Retired: the response column is --response (-o names the file)")
+      ->check([](const std::string&) {
+        return std::string("--output no longer names the response column: use --response COL (-o names the file "
+                           "written)");
+      });
+  cmd->add_option("--excitation", a->excitation,
+                  "Excitation CSV the drive played (servotwin frf excitation): the recording is aligned with it and "
+                  "estimated as its type allows (per-period DFT, H1 of a single sweep, or one line per sine step)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("-o", a->file_out, "Frequency-response CSV to write ('-' = stdout)")->required();
   cmd->add_option("--method", a->method,
                   "h1: Welch-averaged Sxy/Sxx for broadband data (noise, chirp, PRBS); multisine: per-period DFT "
@@ -171,8 +232,8 @@ void add_estimate(CLI::App& frf, Action& selected) {
   cmd->add_option("--fmax", a->fmax, "h1: highest frequency written [Hz]");
   cmd->add_option("--periods", a->periods, "multisine: whole periods in the record (the period is the record / N)");
   cmd->add_option("--period", a->period, "multisine: samples per period (instead of or with --periods)");
-  cmd->add_option("--skip-periods", a->skip_periods, "multisine: leading periods dropped as transient")
-      ->capture_default_str();
+  cmd->add_option("--skip-periods", a->skip_periods,
+                  "multisine: leading periods dropped as transient (default 0; 1 with --excitation)");
   cmd->add_option("--excitation-threshold-db", a->threshold_db,
                   "multisine: excited lines are within this many dB (< 0) of the strongest input line (default: the "
                   "largest gap in the input line powers)");
@@ -182,10 +243,10 @@ void add_estimate(CLI::App& frf, Action& selected) {
       ->check(CLI::IsMember({"auto", "none", "mean", "linear"}))
       ->capture_default_str();
   set_examples(*cmd,
-               "  servotwin frf estimate MultisineTypeA.csv --input iq_adx --output theta_mx --method multisine "
+               "  servotwin frf estimate MultisineTypeA.csv --input iq_adx --response theta_mx --method multisine "
                "--periods 20 --skip-periods 1 -o frf.csv\n"
-               "  servotwin frf estimate run.csv --input u --output y --method h1 --segment 4096 -o frf.csv\n"
-               "  servotwin frf estimate log.csv --fs 8000 --input torque --output speed -o frf.csv --force\n");
+               "  servotwin frf estimate run.csv --input u --response y --method h1 --segment 4096 -o frf.csv\n"
+               "  servotwin frf estimate log.csv --fs 8000 --input torque --response speed -o frf.csv --force\n");
   cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run_estimate(*a, g); }; });
 }
 
@@ -204,25 +265,6 @@ struct MeasureArgs {
   std::string out;
   std::string trace;
 };
-
-/// "1:500" -> (1, 500) Hz.
-std::pair<double, double> parse_range(const std::string& text) {
-  const auto colon = text.find(':');
-  const auto fail = [&] {
-    return core::InputError(core::at_field("--range-hz"), "expected BEGIN:END in Hz, e.g. 1:500, got \"" + text + "\"");
-  };
-  if (colon == std::string::npos) throw fail();
-  try {
-    std::size_t used_a = 0, used_b = 0;
-    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
-    const double begin = std::stod(a, &used_a);
-    const double end = std::stod(b, &used_b);
-    if (used_a != a.size() || used_b != b.size()) throw fail();
-    return {begin, end};
-  } catch (const std::logic_error&) {
-    throw fail();
-  }
-}
 
 std::string state_name(frf::RfidState state) {
   switch (state) {
@@ -263,7 +305,7 @@ int run_measure(const MeasureArgs& a, const GlobalOptions& global) {
   const machine::PlantConfig config = io::load_plant(a.plant);
   machine::FlexiblePlant plant(config);
   vcnc::FrfExperimentSettings settings;
-  std::tie(settings.f_begin_hz, settings.f_end_hz) = parse_range(a.range);
+  std::tie(settings.f_begin_hz, settings.f_end_hz) = parse_range_hz(a.range, "--range-hz");
   settings.points = a.points;
   settings.amplitude = a.amplitude;
   settings.max_amplitude = a.max_amplitude;
@@ -335,11 +377,12 @@ void add_measure(CLI::App& frf, Action& selected) {
 }  // namespace
 
 void register_frf(CLI::App& app, Action& selected) {
-  CLI::App* frf = app.add_subcommand("frf", "Frequency responses: measure one on a simulated plant, or estimate one "
-                                            "from recorded data");
+  CLI::App* frf = app.add_subcommand("frf", "Frequency responses: measure one on a simulated plant, estimate one "
+                                            "from recorded data, or write an excitation for a drive to play");
   frf->require_subcommand(1);
   add_measure(*frf, selected);
   add_estimate(*frf, selected);
+  add_excitation(*frf, selected);
 }
 
 }  // namespace servotwin::cli

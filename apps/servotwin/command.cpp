@@ -3,6 +3,8 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <stdexcept>
+#include <utility>
 
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/program_file.hpp"
@@ -20,6 +22,24 @@ void check_below_nyquist(double freq_hz, double ts, const std::string& option) {
   if (freq_hz >= nyquist_hz)
     throw core::InputError(core::at_field(option), fmt::format("{} Hz is at or beyond the Nyquist frequency {} Hz of --ts {} s",
                                                                freq_hz, nyquist_hz, ts));
+}
+
+std::pair<double, double> parse_range_hz(const std::string& text, const std::string& option) {
+  const auto fail = [&] {
+    return core::InputError(core::at_field(option), "expected BEGIN:END in Hz, e.g. 1:500, got \"" + text + "\"");
+  };
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) throw fail();
+  try {
+    std::size_t used_a = 0, used_b = 0;
+    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+    const double begin = std::stod(a, &used_a);
+    const double end = std::stod(b, &used_b);
+    if (used_a != a.size() || used_b != b.size()) throw fail();
+    return {begin, end};
+  } catch (const std::logic_error&) {
+    throw fail();
+  }
 }
 
 std::unique_ptr<io::OutputFile> open_output(const std::string& path, const GlobalOptions& global) {

@@ -71,6 +71,10 @@ void check_sample_period(double ts, const std::string& option = "--ts");
 /// the sample period ts (a shaper or controller for that mode cannot run at ts).
 void check_below_nyquist(double freq_hz, double ts, const std::string& option);
 
+/// "1:500" -> (1, 500): a frequency range BEGIN:END in Hz (core::InputError naming `option`
+/// unless both are numbers; their order and signs are checked by the caller).
+std::pair<double, double> parse_range_hz(const std::string& text, const std::string& option);
+
 /// Parses axis lists such as "X", "xy", "X,Y" (repeatable option values) into axes.
 std::vector<motion::Axis> parse_axes(const std::vector<std::string>& values, const std::string& option);
 

@@ -22,6 +22,13 @@ class RealDft {
     fft_.fwd(out.data(), in.data(), static_cast<Eigen::Index>(in.size()));
   }
 
+  /// The inverse: `in` holds lines 0 … n/2 of a real sequence of n samples; `out` receives
+  /// x[m] = (1/n) Σ_k X(k) e^{+j2πkm/n} over the full (Hermitian) spectrum.
+  void inverse(const std::vector<std::complex<double>>& in, std::size_t n, std::vector<double>& out) {
+    out.resize(n);
+    fft_.inv(out.data(), in.data(), static_cast<Eigen::Index>(n));
+  }
+
  private:
   Eigen::FFT<double> fft_;
 };

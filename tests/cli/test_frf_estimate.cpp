@@ -25,7 +25,7 @@ class FrfEstimate : public Cli {};
 
 TEST_F(FrfEstimate, MultisineOnTheFdiToolsRecording) {
   const auto r = run("frf estimate '" + kFdiTools +
-                     "MultisineTypeA.csv' --input iq_adx --output theta_mx --method multisine --periods 20 "
+                     "MultisineTypeA.csv' --input iq_adx --response theta_mx --method multisine --periods 20 "
                      "--skip-periods 1 -o frf.csv");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("50000 samples at 2500 Hz (from time_us)"));
@@ -49,12 +49,12 @@ TEST_F(FrfEstimate, MultisineOnTheFdiToolsRecording) {
 
   // The file exists now: refused without --force (nothing changed), replaced with it.
   const auto again = run("frf estimate '" + kFdiTools +
-                         "MultisineTypeB.csv' --input iq_adx --output theta_mx --method multisine --periods 20 -o frf.csv");
+                         "MultisineTypeB.csv' --input iq_adx --response theta_mx --method multisine --periods 20 -o frf.csv");
   EXPECT_EQ(again.status, 3);
   EXPECT_THAT(again.err, HasSubstr("frf.csv"));
   EXPECT_EQ(slurp(path("frf.csv")), text);
   const auto forced = run("frf estimate '" + kFdiTools +
-                          "MultisineTypeB.csv' --input iq_adx --output theta_mx --method multisine --periods 20 "
+                          "MultisineTypeB.csv' --input iq_adx --response theta_mx --method multisine --periods 20 "
                           "--skip-periods 1 -o frf.csv -f -q");
   ASSERT_EQ(forced.status, 0) << forced.err;
   EXPECT_EQ(forced.err, "");  // --quiet
@@ -78,7 +78,7 @@ std::string noise_record(std::size_t n) {
 
 TEST_F(FrfEstimate, H1WithSampleRateOption) {
   write("rec.csv", noise_record(8192));
-  const auto r = run("frf estimate rec.csv --fs 1000 --input u --output y --segment 512 --fmax 400 -o h1.csv");
+  const auto r = run("frf estimate rec.csv --fs 1000 --input u --response y --segment 512 --fmax 400 -o h1.csv");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("(--fs)"));
   EXPECT_THAT(r.err, HasSubstr("31 segments of 512 samples"));
@@ -95,42 +95,47 @@ TEST_F(FrfEstimate, H1WithSampleRateOption) {
 
 TEST_F(FrfEstimate, BadInputExitsWithThreeAndNamesWhere) {
   write("rec.csv", "t,u,y,c\n0,1,2,5\n0.001,2,1,5\n0.002,0,3,5\n0.0035,1,1,5\n0.004,2,2,5\n");
-  auto r = run("frf estimate rec.csv --input iq --output y -o out.csv");
+  auto r = run("frf estimate rec.csv --input iq --response y -o out.csv");
   EXPECT_EQ(r.status, 3);
   EXPECT_THAT(r.err, HasSubstr("rec.csv:1 (iq): missing column 'iq' (columns: t, u, y, c)"));
-  r = run("frf estimate rec.csv --input u --output y -o out.csv");
+  r = run("frf estimate rec.csv --input u --response y -o out.csv");
   EXPECT_EQ(r.status, 3);
   EXPECT_THAT(r.err, HasSubstr("rec.csv:5 (t): non-uniform sampling"));
 
   write("even.csv", "t,u,y,c\n0,1,2,5\n0.001,2,1,5\n0.002,0,3,5\n0.003,1,1,5\n");
-  r = run("frf estimate even.csv --input c --output y -o out.csv");
+  r = run("frf estimate even.csv --input c --response y -o out.csv");
   EXPECT_EQ(r.status, 3);
   EXPECT_THAT(r.err, HasSubstr("column 'c' is constant"));
-  r = run("frf estimate even.csv --input u --output y -o out.csv");
+  r = run("frf estimate even.csv --input u --response y -o out.csv");
   EXPECT_EQ(r.status, 3);
   EXPECT_THAT(r.err, HasSubstr("even.csv (u): at least 16 samples"));
 
   write("nan.csv", "t,u,y\n0,1,2\n0.001,nan,1\n");
-  r = run("frf estimate nan.csv --input u --output y -o out.csv");
+  r = run("frf estimate nan.csv --input u --response y -o out.csv");
   EXPECT_EQ(r.status, 3);
   EXPECT_THAT(r.err, HasSubstr("nan.csv:3:7: column 'u'"));
 
   write("rec2.csv", noise_record(400));
-  r = run("frf estimate rec2.csv --fs 100 --input u --output y --method multisine -o out.csv");
+  r = run("frf estimate rec2.csv --fs 100 --input u --response y --method multisine -o out.csv");
   EXPECT_EQ(r.status, 3);
-  EXPECT_THAT(r.err, HasSubstr("(--periods): give the number of periods"));
-  r = run("frf estimate rec2.csv --fs 100 --input u --output y --method multisine --periods 4 -o out.csv");
+  // White noise has no period to detect (the periodic estimator needs one).
+  EXPECT_THAT(r.err, HasSubstr("(--period): no period found in the input"));
+  r = run("frf estimate rec2.csv --fs 100 --input u --response y --method multisine --periods 4 -o out.csv");
   EXPECT_EQ(r.status, 3);
   EXPECT_THAT(r.err, HasSubstr("cannot tell excited lines from the rest"));
-  r = run("frf estimate rec2.csv --fs 100 --input u --output y --segment 8 -o out.csv");
+  r = run("frf estimate rec2.csv --fs 100 --input u --response y --segment 8 -o out.csv");
   EXPECT_EQ(r.status, 3);
   EXPECT_THAT(r.err, HasSubstr("(--segment)"));
   EXPECT_FALSE(std::filesystem::exists(path("out.csv")));
 
   // Usage errors: unknown method, missing required option, missing sub-subcommand.
-  EXPECT_EQ(run("frf estimate rec2.csv --fs 100 --input u --output y --method h2 -o out.csv").status, 2);
+  EXPECT_EQ(run("frf estimate rec2.csv --fs 100 --input u --response y --method h2 -o out.csv").status, 2);
   EXPECT_EQ(run("frf estimate rec2.csv --fs 100 --input u -o out.csv").status, 2);
   EXPECT_EQ(run("frf").status, 2);
+  // Issue 25 §7: --output names only files; the response column moved to --response.
+  r = run("frf estimate rec2.csv --fs 100 --input u --output y -o out.csv");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.err, HasSubstr("use --response COL"));
 }
 
 }  // namespace
