@@ -34,6 +34,8 @@ struct EstimateArgs {
   std::string input, response;
   std::string retired_output;  // the old name of --response, refused with a pointer to it
   std::string excitation;      // the design the drive played (frf excitation)
+  bool closed_loop = false;
+  std::string reference;       // closed loop: the excited reference column
   std::string method = "h1";
   std::string file_out;
   std::string time_column;
@@ -61,7 +63,10 @@ frf::Detrend detrend_of(const std::string& text, frf::Detrend fallback) {
 /// Estimator errors name an option or a signal; say which file and column they concern.
 [[noreturn]] void rethrow_located(const core::InputError& e, const EstimateArgs& a) {
   const std::string& field = e.where().field;
-  std::string where = field == "input" ? a.input : field == "output" ? a.response : "--" + field;
+  std::string where = field == "input"       ? a.input
+                      : field == "output"    ? a.response
+                      : field == "reference" ? a.reference
+                                             : "--" + field;
   throw core::InputError({a.data, 0, 0, where}, e.reason());
 }
 
@@ -85,8 +90,10 @@ std::size_t detected_period(const std::vector<double>& x, const GlobalOptions& g
 Estimated estimate(const EstimateArgs& a, const io::SignalTable& table, const GlobalOptions& global) {
   const std::vector<double>& x = table.column(a.input);
   const std::vector<double>& y = table.column(a.response);
+  const std::vector<double>* r = a.closed_loop ? &table.column(a.reference) : nullptr;
   Estimated out;
-  out.comments.push_back("source: " + a.data + ", input: " + a.input + ", output: " + a.response);
+  out.comments.push_back("source: " + a.data + ", input: " + a.input + ", output: " + a.response +
+                         (r ? ", reference: " + a.reference + " (closed loop, indirect method)" : std::string()));
   try {
     if (a.method == "h1") {
       frf::WelchOptions o;
@@ -96,11 +103,11 @@ Estimated estimate(const EstimateArgs& a, const io::SignalTable& table, const Gl
       o.detrend = detrend_of(a.detrend, frf::Detrend::kMean);
       o.min_freq_hz = a.fmin;
       o.max_freq_hz = a.fmax;
-      const frf::WelchSpectra s = frf::welch_spectra(x, y, table.ts, o);
-      out.response = frf::h1_from_spectra(s, table.ts, x.size(), o);
-      out.comments.push_back(fmt::format("method: h1 (Welch), segment {} samples, {} window, overlap {}, {} segments "
+      const frf::WelchSpectra s = frf::welch_spectra(r ? *r : x, y, table.ts, o);
+      out.response = r ? frf::estimate_closed_loop_h1(*r, x, y, table.ts, o) : frf::h1_from_spectra(s, table.ts, x.size(), o);
+      out.comments.push_back(fmt::format("method: {} (Welch), segment {} samples, {} window, overlap {}, {} segments "
                                          "({:.1f} effective averages), df {} Hz",
-                                         s.segment_length, a.window, a.overlap, s.segments, s.effective_averages,
+                                         r ? "closed loop, indirect S_ry/S_ru" : "h1", s.segment_length, a.window, a.overlap, s.segments, s.effective_averages,
                                          s.df_hz));
       progress(global, "H1: {} segments of {} samples ({:.1f} effective averages), df {} Hz", s.segments,
                s.segment_length, s.effective_averages, s.df_hz);
@@ -109,10 +116,11 @@ Estimated estimate(const EstimateArgs& a, const io::SignalTable& table, const Gl
       o.periods = a.periods;
       o.period_samples = a.period;
       o.skip_periods = a.skip_periods.value_or(0);
-      if (o.periods == 0 && o.period_samples == 0) o.period_samples = detected_period(x, global);
+      if (o.periods == 0 && o.period_samples == 0) o.period_samples = detected_period(r ? *r : x, global);
       o.detrend = detrend_of(a.detrend, frf::Detrend::kLinear);
       o.excitation_threshold_db = a.threshold_db;
-      frf::MultisineEstimate e = frf::estimate_multisine(x, y, table.ts, o);
+      frf::MultisineEstimate e =
+          r ? frf::estimate_closed_loop_multisine(*r, x, y, table.ts, o) : frf::estimate_multisine(x, y, table.ts, o);
       out.comments.push_back(fmt::format("method: multisine (per-period DFT), period {} samples, {} periods used, {} "
                                          "skipped, {} excited lines, df {} Hz",
                                          e.period_samples, e.periods_used, e.periods_skipped, e.lines.size(), e.df_hz));
@@ -172,13 +180,19 @@ void print_summary(const core::FrequencyResponse& r) {
 int run_estimate(const EstimateArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   io::SignalReadOptions reading;
+  if (a.closed_loop && a.reference.empty())
+    throw core::InputError(core::at_field("--reference"),
+                           "a closed-loop estimate needs the excited reference column: the plant is P = S_ry/S_ru, "
+                           "and without r the noise fed back through the loop biases it");
   reading.columns = {a.input};
-  if (a.response != a.input) reading.columns.push_back(a.response);
+  for (const std::string* c : {&a.response, &a.reference})
+    if (!c->empty() && std::find(reading.columns.begin(), reading.columns.end(), *c) == reading.columns.end())
+      reading.columns.push_back(*c);
   reading.time_column = a.time_column;
   reading.fs = a.fs;
   reading.max_jitter = a.max_jitter;
   const io::SignalTable table = io::read_signal_file(a.data, reading);
-  io::require_varying(table, a.input);
+  io::require_varying(table, a.closed_loop ? a.reference : a.input);
   progress(global, "read {}: {} samples at {} Hz{} in {:.1f} ms", a.data, table.size(), 1.0 / table.ts,
            table.time_column.empty() ? " (--fs)" : " (from " + table.time_column + ")", elapsed_ms(start));
 
@@ -206,6 +220,10 @@ void add_estimate(CLI::App& frf, Action& selected) {
         return std::string("--output no longer names the response column: use --response COL (-o names the file "
                            "written)");
       });
+  auto* closed = cmd->add_flag("--closed-loop", a->closed_loop,
+                               "The record was taken inside a closed loop whose reference was excited: estimate the "
+                               "plant (input -> response) by the indirect method P = S_ry/S_ru (needs --reference)");
+  cmd->add_option("--reference", a->reference, "Closed loop: the column of the excited reference")->needs(closed);
   cmd->add_option("--excitation", a->excitation,
                   "Excitation CSV the drive played (servotwin frf excitation): the recording is aligned with it and "
                   "estimated as its type allows (per-period DFT, H1 of a single sweep, or one line per sine step)")

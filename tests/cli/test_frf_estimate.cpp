@@ -139,3 +139,52 @@ TEST_F(FrfEstimate, BadInputExitsWithThreeAndNamesWhere) {
 }
 
 }  // namespace
+
+namespace {
+
+/// r white, u = 2 (r − y_m), y_m = P u + v with P = (0.05 z⁻¹ + 0.02 z⁻²)/(1 − 1.6 z⁻¹ + 0.9 z⁻²):
+/// the loop of tests/frf/test_offline_closed_loop.cpp, as a drive would log it.
+std::string closed_loop_record(std::size_t n) {
+  std::mt19937 rng(4);
+  std::normal_distribution<double> white(0.0, 1.0);
+  std::ostringstream text;
+  text.precision(17);
+  text << "t,r,u,y\n";
+  double u1 = 0, u2 = 0, y1 = 0, y2 = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double r = white(rng);
+    const double y = 0.05 * u1 + 0.02 * u2 + 1.6 * y1 - 0.9 * y2;
+    const double measured = y + 0.3 * white(rng);
+    const double u = 2.0 * (r - measured);
+    text << static_cast<double>(k) * 1e-3 << ',' << r << ',' << u << ',' << measured << '\n';
+    u2 = u1;
+    u1 = u;
+    y2 = y1;
+    y1 = y;
+  }
+  return text.str();
+}
+
+TEST_F(FrfEstimate, ClosedLoopIndirectMethod) {
+  write("loop.csv", closed_loop_record(65536));
+  auto r = run("frf estimate loop.csv --closed-loop --reference r --input u --response y --segment 1024 -o cl.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string text = slurp(path("cl.csv"));
+  EXPECT_THAT(text, HasSubstr("reference: r (closed loop, indirect method)"));
+  EXPECT_THAT(text, HasSubstr("method: closed loop, indirect S_ry/S_ru (Welch)"));
+  const auto closed = servotwin::io::read_frf_file(path("cl.csv").string());
+  // Near DC the plant is P(1) = 0.07/0.3 = 0.2333 (the loop keeps |S| = 0.68 there).
+  EXPECT_NEAR(std::abs(closed.points[1].value), 0.2333, 0.02);
+  // A closed-loop record without its reference is bad input (exit 3); --reference alone is a
+  // usage error (exit 2).
+  r = run("frf estimate loop.csv --closed-loop --input u --response y -o x.csv");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("(--reference): a closed-loop estimate needs the excited reference column"));
+  EXPECT_FALSE(std::filesystem::exists(path("x.csv")));
+  EXPECT_EQ(run("frf estimate loop.csv --reference r --input u --response y -o x.csv").status, 2);
+  r = run("frf estimate loop.csv --closed-loop --reference nope --input u --response y -o x.csv");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_THAT(r.err, HasSubstr("missing column 'nope'"));
+}
+
+}  // namespace

@@ -150,4 +150,29 @@ struct MultisineEstimate {
 MultisineEstimate estimate_multisine(std::span<const double> x, std::span<const double> y, double ts,
                                      const MultisineOptions& options);
 
+/// Closed-loop estimate of a plant from a record taken inside a loop whose reference r was excited
+/// (issue 25 §3): the indirect (joint input-output) method P = S_ry / S_ru with Welch-averaged
+/// cross spectra (Pintelon & Schoukens 2012, section 2.6.4; L. Ljung, "System Identification",
+/// 2nd ed. 1999, section 13.5). Measurement and process noise feed back into u, so the open-loop
+/// H1 = S_uy/S_uu is biased (towards −1/C where the noise dominates); r is uncorrelated with the
+/// noise, so the ratio of the cross spectra with r is not.
+/// Per point: quality = min(γ²_ru, γ²_ry), the weaker coherence of the two paths; std_dev from
+/// first-order propagation, E|P̂ − P|² = S_zz·S_rr / (n·|S_ru|²) with z = y − P̂u (the part of y
+/// not explained by the plant, uncorrelated with r) and n the effective number of averages;
+/// amplitude = the reference's, as in estimate_h1. Lines where S_ru is 0 are left out.
+/// quality_kind = kCoherence. r, u, y of the same length (core::InputError naming "reference"
+/// otherwise, or "input"/"output" as estimate_h1).
+core::FrequencyResponse estimate_closed_loop_h1(std::span<const double> r, std::span<const double> u,
+                                                std::span<const double> y, double ts,
+                                                const WelchOptions& options = {});
+
+/// Closed-loop estimate with a periodic reference: the excited lines are detected on r (as
+/// estimate_multisine does on its input, or taken from `options.excited_lines`), then
+/// P = Ȳ/Ū on those lines over the periods: averaging removes the noise from both before the
+/// ratio, and the noise (co)variances of U and Y, correlated through the loop, enter σ_G as in
+/// estimate_multisine.
+MultisineEstimate estimate_closed_loop_multisine(std::span<const double> r, std::span<const double> u,
+                                                 std::span<const double> y, double ts,
+                                                 const MultisineOptions& options);
+
 }  // namespace servotwin::frf
