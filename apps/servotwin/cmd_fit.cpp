@@ -151,7 +151,7 @@ void register_fit(CLI::App& app, Action& selected) {
                   "two-mass (rigid mode + one mode, C5.7), modes:N (N flexible modes) or auto (order chosen by BIC, or by "
                   "the noise level when the file has std)")
       ->capture_default_str();
-  cmd->add_option("--output", a->output_kind, "Measured output: velocity, position, or auto (from the low-frequency slope)")
+  cmd->add_option("--output-kind", a->output_kind, "Measured output: velocity, position, or auto (from the low-frequency slope)")
       ->check(CLI::IsMember({"auto", "velocity", "position"}))
       ->capture_default_str();
   cmd->add_option("--rigid", a->rigid, "Rigid-body mode: pole (K/(s+a), viscous friction) or integrator (K/s)")
@@ -165,7 +165,12 @@ void register_fit(CLI::App& app, Action& selected) {
   cmd->add_option("--max-iterations", a->max_iterations, "Levenberg-Marquardt iteration limit per start")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  cmd->add_option("-o,--out", a->out, "Write the model (servotwin.plant-model/1 JSON; - for stdout)");
+  add_output_file_option(*cmd, a->out, "Write the model (servotwin.plant-model/1 JSON; - for stdout)")
+      ->check([](const std::string& value) {
+        return value == "velocity" || value == "position" || value == "auto"
+                   ? std::string("--output names the file written now; the measured output is --output-kind " + value)
+                   : std::string();
+      });
   cmd->add_option("--amplitude-series", a->amplitude_series,
                   "Responses of the same plant measured at other excitation amplitudes (the main file should be the "
                   "largest): Coulomb friction and backlash from their describing functions")
@@ -174,7 +179,7 @@ void register_fit(CLI::App& app, Action& selected) {
   set_examples(*cmd,
                "  servotwin fit frf.csv -o plant_model.json --report fit.html\n"
                "  servotwin fit frf.csv --model modes:2 --lag -o plant_model.json\n"
-               "  servotwin fit frf.csv --model auto --output velocity --rigid integrator\n"
+               "  servotwin fit frf.csv --model auto --output-kind velocity --rigid integrator\n"
                "  servotwin fit frf_2Nm.csv --delay --amplitude-series frf_0.25Nm.csv -o plant_model.json\n");
   cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });
 }

@@ -32,7 +32,7 @@ namespace {
 struct EstimateArgs {
   std::string data;
   std::string input, response;
-  std::string retired_output;  // the old name of --response, refused with a pointer to it
+  std::vector<std::string> files_out;  // -o/--output; two of them are an old --output COL
   std::string excitation;      // the design the drive played (frf excitation)
   bool closed_loop = false;
   std::string reference;       // closed loop: the excited reference column
@@ -214,12 +214,8 @@ void add_estimate(CLI::App& frf, Action& selected) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--input", a->input, "Column of the excitation (input)")->required();
-  cmd->add_option("--response", a->response, "Column of the response (output)")->required();
-  cmd->add_option("--output", a->retired_output, "Retired: the response column is --response (-o names the file)")
-      ->check([](const std::string&) {
-        return std::string("--output no longer names the response column: use --response COL (-o names the file "
-                           "written)");
-      });
+  // Required, checked in the callback so that an old invocation (--output COL) is told about it.
+  cmd->add_option("--response", a->response, "Column of the response (output); required");
   auto* closed = cmd->add_flag("--closed-loop", a->closed_loop,
                                "The record was taken inside a closed loop whose reference was excited: estimate the "
                                "plant (input -> response) by the indirect method P = S_ry/S_ru (needs --reference)");
@@ -228,7 +224,11 @@ void add_estimate(CLI::App& frf, Action& selected) {
                   "Excitation CSV the drive played (servotwin frf excitation): the recording is aligned with it and "
                   "estimated as its type allows (per-period DFT, H1 of a single sweep, or one line per sine step)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("-o", a->file_out, "Frequency-response CSV to write ('-' = stdout)")->required();
+  // -o/--output names the file; before, --output named the response column, so an invocation with
+  // both is an old one: refused with a pointer to --response rather than read as two files.
+  cmd->add_option("-o,--output", a->files_out, "Frequency-response CSV to write ('-' = stdout)")
+      ->required()
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option("--method", a->method,
                   "h1: Welch-averaged Sxy/Sxx for broadband data (noise, chirp, PRBS); multisine: per-period DFT "
                   "averages for periodic excitation")
@@ -246,8 +246,10 @@ void add_estimate(CLI::App& frf, Action& selected) {
   cmd->add_option("--window", a->window, "h1: window of each segment: hann or rect")
       ->check(CLI::IsMember({"hann", "rect"}))
       ->capture_default_str();
-  cmd->add_option("--fmin", a->fmin, "h1: lowest frequency written [Hz]");
-  cmd->add_option("--fmax", a->fmax, "h1: highest frequency written [Hz]");
+  cmd->add_option("--fmin-hz", a->fmin, "h1: lowest frequency written [Hz]");
+  cmd->add_option("--fmax-hz", a->fmax, "h1: highest frequency written [Hz]");
+  add_old_spelling(*cmd, "--fmin", a->fmin, "--fmin-hz");
+  add_old_spelling(*cmd, "--fmax", a->fmax, "--fmax-hz");
   cmd->add_option("--periods", a->periods, "multisine: whole periods in the record (the period is the record / N)");
   cmd->add_option("--period", a->period, "multisine: samples per period (instead of or with --periods)");
   cmd->add_option("--skip-periods", a->skip_periods,
@@ -265,7 +267,14 @@ void add_estimate(CLI::App& frf, Action& selected) {
                "--periods 20 --skip-periods 1 -o frf.csv\n"
                "  servotwin frf estimate run.csv --input u --response y --method h1 --segment 4096 -o frf.csv\n"
                "  servotwin frf estimate log.csv --fs 8000 --input torque --response speed -o frf.csv --force\n");
-  cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run_estimate(*a, g); }; });
+  cmd->callback([a, &selected] {
+    if (a->files_out.size() > 1)
+      throw CLI::ValidationError("--output", "--output no longer names the response column: use --response COL "
+                                             "(-o/--output names the file written)");
+    if (a->response.empty()) throw CLI::RequiredError("--response");
+    a->file_out = a->files_out.front();
+    selected = [a](const GlobalOptions& g) { return run_estimate(*a, g); };
+  });
 }
 
 
@@ -384,7 +393,7 @@ void add_measure(CLI::App& frf, Action& selected) {
                   "Stop the simulation after this much experiment time [s] (default: max(120 s, 200 periods of the "
                   "first frequency + 4 sweep times))");
   cmd->add_flag("--open-loop", a->open_loop, "No semi-closed loop on the DC estimate (velocity outputs)");
-  cmd->add_option("-o", a->out, "Frequency-response CSV to write ('-' = stdout)")->required();
+  add_output_file_option(*cmd, a->out, "Frequency-response CSV to write ('-' = stdout)")->required();
   cmd->add_option("--trace", a->trace, "Also write every sample (t, mv, pv, f_hz, amplitude, thd, state) as CSV");
   set_examples(*cmd,
                "  servotwin frf measure --plant motor-bench --range-hz 1:500 -o frf.csv\n"

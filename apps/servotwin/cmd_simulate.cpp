@@ -17,10 +17,12 @@
 #include "servotwin/io/drive_simulation_csv.hpp"
 #include "servotwin/io/frame_sequence_csv.hpp"
 #include "servotwin/io/plant_json.hpp"
+#include "servotwin/io/plant_model_json.hpp"
 #include "servotwin/io/shaper_json.hpp"
 #include "servotwin/report/drive_report.hpp"
 #include "servotwin/vcnc/drive_simulation.hpp"
 #include "servotwin/vcnc/frame_sequence.hpp"
+#include "servotwin/vcnc/plant_realization.hpp"
 
 namespace servotwin::cli {
 
@@ -38,11 +40,39 @@ struct SimulateArgs {
   std::string report;
   double load_force = 0.1, stator_force = 0.1;  // frame-sequence only
   std::string shaper;                          // frame-sequence only
+  std::optional<double> ts;                    // a plant realized from a fitted model
 };
+
+/// A fitted plant model (servotwin.plant-model/1) as a simulated plant: the two-mass realization
+/// when the controller needs the load side, else the exact transfer function; at --ts, else at
+/// the controller's discrete period.
+machine::PlantConfig realized_model(const SimulateArgs& a, const io::LoadedController& loaded, const std::string& path) {
+  const fit::PlantModel model = io::load_plant_model(path).model;
+  const tuning::Structure s = loaded.controller.structure;
+  const bool load_side = tuning::measures_load(s) || tuning::measures_both(s);
+  double ts = 0.0;
+  if (a.ts) ts = *a.ts;
+  else if (loaded.controller.discrete) ts = loaded.controller.discrete->ts;
+  else
+    throw core::InputError(core::at_field("--ts"),
+                           "the plant is a fitted model (" + path + "): give the sample period to simulate it at (the "
+                           "controller has no discrete form; tune with --ts to give it one), or a plant description "
+                           "with --plant");
+  try {
+    machine::PlantConfig plant = vcnc::realize_plant_model(
+        model, load_side ? vcnc::Realization::kTwoMass : vcnc::Realization::kTransferFunction, ts);
+    plant.name = path;
+    return plant;
+  } catch (const core::InputError& e) {
+    if (e.where().field == "ts") throw core::InputError(core::at_field("--ts"), e.reason());
+    throw core::InputError({path, 0, 0, "model"}, e.reason());
+  }
+}
 
 /// The plant to run: --plant, else the plant description the controller was tuned from.
 machine::PlantConfig plant_to_run(const SimulateArgs& a, const io::LoadedController& loaded, std::string& source) {
   source = a.plant.empty() ? loaded.plant_source : a.plant;
+  if (io::is_plant_model_file(source)) return realized_model(a, loaded, source);
   if (!a.plant.empty()) return io::load_plant(a.plant);
   try {
     return io::load_plant(loaded.plant_source);
@@ -235,6 +265,10 @@ void register_simulate(CLI::App& app, Action& selected) {
   cmd->add_option("--controller", a->controller, "Controller file (servotwin.controller/1 from `servotwin tune`)")
       ->required()
       ->check(CLI::ExistingFile);
+  cmd->add_option("--ts", a->ts,
+                  "Sample period [s] of a plant realized from a fitted model (servotwin.plant-model/1; default: the "
+                  "controller's discrete period)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--plant", a->plant,
                   "Plant description (servotwin.plant/1) or flexible preset name; default: the plant the controller "
                   "was tuned from, when that was a description or preset");
@@ -253,7 +287,7 @@ void register_simulate(CLI::App& app, Action& selected) {
       ->capture_default_str();
   cmd->add_option("--torque-limit", a->torque_limit, "Limit of the torque command (anti-windup by conditional integration)");
   cmd->add_option("--band", a->band, "Settling band relative to the step")->capture_default_str();
-  cmd->add_option("-o,--out", a->out, "Write the samples (CSV; - for stdout)");
+  add_output_file_option(*cmd, a->out, "Write the samples (CSV; - for stdout)");
   add_report_option(*cmd, a->report);
   set_examples(*cmd,
                "  servotwin tune motor-bench -o pi.json && servotwin simulate --controller pi.json -o step.csv\n"

@@ -367,7 +367,7 @@ void register_tune(CLI::App& app, Action& selected) {
   add_spec_options(*cmd, a->spec);
   cmd->add_option("--setpoint-weight", a->setpoint_weight, "Proportional setpoint weight wp in [0, 1] (2-DoF)")
       ->capture_default_str();
-  cmd->add_option("-o,--out", a->out, "Write the controller (servotwin.controller/1 JSON; - for stdout)");
+  add_output_file_option(*cmd, a->out, "Write the controller (servotwin.controller/1 JSON; - for stdout)");
   add_report_option(*cmd, a->report);
   set_examples(*cmd,
                "  servotwin tune plant_model.json -o controller.json\n"

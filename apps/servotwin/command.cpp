@@ -42,6 +42,12 @@ std::pair<double, double> parse_range_hz(const std::string& text, const std::str
   }
 }
 
+CLI::Option* add_output_file_option(CLI::App& command, std::string& target, const std::string& help) {
+  CLI::Option* option = command.add_option("-o,--output", target, help);
+  add_old_spelling(command, "--out", target, "-o/--output");
+  return option;
+}
+
 std::unique_ptr<io::OutputFile> open_output(const std::string& path, const GlobalOptions& global) {
   return std::make_unique<io::OutputFile>(path, global.force ? io::Overwrite::Allow : io::Overwrite::Refuse);
 }

@@ -105,6 +105,22 @@ void add_program_reading_options(CLI::App& command, ProgramSource& source);
 /// Reads the program starting from `start`, printing lenient-mode warnings on stderr.
 motion::Program load_program(const ProgramSource& source, const motion::Point& start = {});
 
+/// Adds `-o,--output` for a file the command writes (issue 25 §7: -o/--output names only files)
+/// and the old spelling `--out` (hidden, with a note on stderr).
+CLI::Option* add_output_file_option(CLI::App& command, std::string& target, const std::string& help);
+
+/// Adds a hidden old spelling `old_name` of the option `new_name` storing into the same
+/// variable; using it prints a note naming the new spelling on stderr.
+template <typename T>
+void add_old_spelling(CLI::App& command, const std::string& old_name, T& target, const std::string& new_name) {
+  command.add_option(old_name, target, "Old spelling of " + new_name)
+      ->group("")
+      ->each([old_name, new_name](const std::string&) {
+        fmt::print(stderr, "servotwin: note: {} is now spelled {}; the old spelling will be removed\n", old_name,
+                   new_name);
+      });
+}
+
 /// Adds the "Examples:" footer shown by --help.
 void set_examples(CLI::App& command, const std::string& examples);
 

@@ -147,7 +147,7 @@ void add_excitation(CLI::App& frf, Action& selected) {
   cmd->add_option("--steps", a->steps, "sine-steps: number of frequencies (default: 10 per decade)");
   cmd->add_option("--settle-fraction", a->settle_fraction, "sine-steps: part of each step before it is measured")
       ->capture_default_str();
-  cmd->add_option("-o", a->out, "Excitation CSV to write ('-' = stdout)")->required();
+  add_output_file_option(*cmd, a->out, "Excitation CSV to write ('-' = stdout)")->required();
   set_examples(*cmd,
                "  servotwin frf excitation --type multisine --range-hz 1:500 --ts 0.001 --duration 30 --amplitude 2 "
                "-o excitation.csv\n"

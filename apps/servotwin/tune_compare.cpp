@@ -92,6 +92,7 @@ void print_comparison(const std::vector<tuning::StructureComparison>& comparison
                comparison_cell(i.phase_margin_deg, "{:.3g}"), comparison_cell(i.min_damping, "{:.3g}"),
                k.full_order && !k.full_order->controller_stable ? "UNSTABLE compensator" : "stable");
   }
+  for (const std::string& note : tuning::comparison_notes(comparison)) fmt::print("note: {}\n", note);
 }
 
 /// Every design run on the plant description with its nonlinearities: a unit setpoint step, then a

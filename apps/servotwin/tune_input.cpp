@@ -17,17 +17,6 @@ namespace servotwin::cli {
 
 namespace {
 
-/// The "format" member of a JSON file, or empty when the file is not a JSON object with one (the
-/// plant-description reader then reports the problem with its position).
-std::string json_format_of(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  const nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("format") || !j["format"].is_string()) return {};
-  return j["format"].get<std::string>();
-}
-
 /// Motor velocity per torque of a plant description (the chain's, or a given TF's).
 core::TransferFunction velocity_tf(const machine::PlantConfig& config, const std::string& source) {
   if (const auto* chain = std::get_if<machine::MassChain>(&config.model)) {
@@ -78,8 +67,7 @@ TunePlant from_description(const machine::PlantConfig& config, const std::string
 }  // namespace
 
 TunePlant load_tune_plant(const std::string& name_or_path) {
-  std::error_code ec;
-  if (std::filesystem::is_regular_file(name_or_path, ec) && json_format_of(name_or_path) == io::kPlantModelFormat) {
+  if (io::is_plant_model_file(name_or_path)) {
     TunePlant p;
     p.model = io::load_plant_model(name_or_path).model;
     p.fitted = true;

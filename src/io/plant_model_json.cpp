@@ -1,6 +1,7 @@
 #include "servotwin/io/plant_model_json.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <sstream>
@@ -217,6 +218,17 @@ LoadedPlantModel load_plant_model(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   return parse_plant_model_json(text.str(), path);
+}
+
+bool is_plant_model_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  const nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, false);
+  return !j.is_discarded() && j.is_object() && j.contains("format") && j["format"].is_string() &&
+         j["format"].get<std::string>() == kPlantModelFormat;
 }
 
 }  // namespace servotwin::io

@@ -1,6 +1,7 @@
 #include "servotwin/tuning/compare.hpp"
 
 #include <algorithm>
+#include <fmt/format.h>
 #include <cmath>
 #include <limits>
 
@@ -47,6 +48,21 @@ double relative_to_pi(const std::vector<StructureComparison>& comparison, double
     if (std::isfinite(pi) && pi != 0.0) return value / pi;
   }
   return std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<std::string> comparison_notes(const std::vector<StructureComparison>& comparison) {
+  std::vector<std::string> notes;
+  for (const StructureComparison& c : comparison) {
+    if (!c.result || c.structure == Structure::kPi) continue;
+    const double itae = c.result->controller.predicted.itae_load_step;
+    const double ratio = relative_to_pi(comparison, &LoopIndices::itae_load_step, itae);
+    if (!(ratio > kFarWorseItae)) continue;
+    notes.push_back(fmt::format("{}: its load-step ITAE is {:.3g} times the PI's: it rejects a load torque much more "
+                                "slowly (weaker integral action) although it wins on bandwidth; prefer the PI where "
+                                "load disturbances matter",
+                                to_string(c.structure), ratio));
+  }
+  return notes;
 }
 
 }  // namespace servotwin::tuning

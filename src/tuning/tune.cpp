@@ -313,16 +313,27 @@ TuneResult::Candidate choose(const std::vector<TuneResult::Candidate>& scan, Eva
                                    parameter, o.ms, o.mt, *o.min_damping, best_damping,
                                    lqg ? "kbw" : hinf ? "w0S/omega_z" : "omega*/omega_z", at_damping));
   }
+  // The nearest limits that work: the best candidate's own peaks, rounded up to three digits so
+  // that the limits printed accept it.
+  const auto round_up = [](double v) {
+    const double scale = std::pow(10.0, 2.0 - std::floor(std::log10(v)));
+    return std::ceil(v * scale * (1.0 - 1e-12)) / scale;
+  };
+  // With W2 the robustness condition decides too: only the direction is known.
+  const std::string advice =
+      o.w2 ? std::string("relax --ms/--mt")
+           : fmt::format("the nearest limits that accept it: --ms {:g} --mt {:g}", std::max(o.ms, round_up(best_s)),
+                         std::max(o.mt, round_up(best_t)));
   throw InputError(at_field(o.w2 ? "--w2" : "--ms"),
                    fmt::format("no {} meets ||S|| <= {} and the tracking peak <= {}{}: the best achievable are "
-                               "||S|| = {:.3g} and {:.3g} at {} = {:.3g}; relax --ms/--mt",
+                               "||S|| = {:.3g} and {:.3g} at {} = {:.3g}; {}",
                                parameter, o.ms, o.mt,
                                !o.w2 ? ""
                                : lqg && !is_position_controller(o.structure)
                                    ? " with robust stability and robust tracking (C7.13)"
                                    : " with robust performance",
                                best_s, best_t,
-                               lqg ? "kbw" : hinf ? "w0S/omega_z" : "omega*/omega_z", at));
+                               lqg ? "kbw" : hinf ? "w0S/omega_z" : "omega*/omega_z", at, advice));
 }
 
 PlantScales scales(const NormalizedPlant& p) { return {p.omega_z, p.motor_inertia, p.r, p.zeta_z, p.zeta_p, p.a}; }

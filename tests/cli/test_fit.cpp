@@ -35,7 +35,7 @@ TEST_F(Cli, FitWritesThePlantModelAndPrintsTheSummary) {
 
 TEST_F(Cli, FitAutoStatesTheCriterion) {
   write("frf.csv", e10_csv(30));
-  const Result r = run("fit frf.csv --model auto --output velocity");
+  const Result r = run("fit frf.csv --model auto --output-kind velocity");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("BIC"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("n = 1"), std::string::npos) << r.out;
@@ -47,7 +47,7 @@ TEST_F(Cli, FitBadOptionsAndData) {
   Result r = run("fit frf.csv --model modes:x");
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("--model"), std::string::npos) << r.err;
-  EXPECT_EQ(run("fit frf.csv --output torque").status, 2);
+  EXPECT_EQ(run("fit frf.csv --output-kind torque").status, 2);
   write("short.csv", e10_csv(3));
   r = run("fit short.csv");
   EXPECT_EQ(r.status, 3);
@@ -57,6 +57,14 @@ TEST_F(Cli, FitBadOptionsAndData) {
   r = run("fit rigid.csv");
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("resonance"), std::string::npos) << r.err;
+  // Issue 25 §7: -o/--output names the file; the measured output kind is --output-kind.
+  const Result kind = run("fit frf.csv --output velocity");
+  EXPECT_EQ(kind.status, 2);
+  EXPECT_NE(kind.err.find("the measured output is --output-kind velocity"), std::string::npos) << kind.err;
+  const Result old = run("fit frf.csv --out old_spelling.json");
+  EXPECT_EQ(old.status, 0) << old.err;
+  EXPECT_NE(old.err.find("note: --out is now spelled -o/--output"), std::string::npos) << old.err;
+  EXPECT_TRUE(std::filesystem::exists(path("old_spelling.json")));
 }
 
 }  // namespace

@@ -78,7 +78,7 @@ std::string noise_record(std::size_t n) {
 
 TEST_F(FrfEstimate, H1WithSampleRateOption) {
   write("rec.csv", noise_record(8192));
-  const auto r = run("frf estimate rec.csv --fs 1000 --input u --response y --segment 512 --fmax 400 -o h1.csv");
+  const auto r = run("frf estimate rec.csv --fs 1000 --input u --response y --segment 512 --fmax-hz 400 -o h1.csv");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("(--fs)"));
   EXPECT_THAT(r.err, HasSubstr("31 segments of 512 samples"));
@@ -132,10 +132,15 @@ TEST_F(FrfEstimate, BadInputExitsWithThreeAndNamesWhere) {
   EXPECT_EQ(run("frf estimate rec2.csv --fs 100 --input u --response y --method h2 -o out.csv").status, 2);
   EXPECT_EQ(run("frf estimate rec2.csv --fs 100 --input u -o out.csv").status, 2);
   EXPECT_EQ(run("frf").status, 2);
-  // Issue 25 §7: --output names only files; the response column moved to --response.
+  // Issue 25 §7: -o/--output names only files; the response column moved to --response, and an
+  // old invocation (--output COL beside -o FILE) is refused with a pointer to it.
   r = run("frf estimate rec2.csv --fs 100 --input u --output y -o out.csv");
   EXPECT_EQ(r.status, 2);
   EXPECT_THAT(r.err, HasSubstr("use --response COL"));
+  r = run("frf estimate rec2.csv --fs 100 --input u --response y --segment 64 --fmax 40 --output h1b.csv");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("note: --fmax is now spelled --fmax-hz"));
+  EXPECT_TRUE(std::filesystem::exists(path("h1b.csv")));
 }
 
 }  // namespace

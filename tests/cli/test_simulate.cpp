@@ -2,10 +2,12 @@
 // through the controller file), its CSV holds the run, the closed-form steady state holds, and the
 // errors users meet are clear.
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 
 #include "cli_support.hpp"
 #include "e10_frf.hpp"
+#include "servotwin/io/plant_model_json.hpp"
 
 namespace servotwin::cli_test {
 namespace {
@@ -205,6 +207,36 @@ TEST_F(Cli, SimulateExplainsWhatItCannotRun) {
   ASSERT_EQ(run("simulate --plant table-5.1 --controller pi.json --duration 1 -o s.csv").status, 0);
   r = run("simulate --plant table-5.1 --controller pi.json --duration 1 -o s.csv");
   EXPECT_EQ(r.status, 3);  // never replaces an existing file without --force
+}
+
+}  // namespace
+}  // namespace servotwin::cli_test
+
+namespace servotwin::cli_test {
+namespace {
+
+// Issue 25 §7: measure -> fit -> tune -> simulate on files. The fitted model is simulated through
+// its transfer-function realization; the closed form of the steady state is the model's own:
+// holding 1 rad/s takes the torque 1/P(0).
+TEST_F(Cli, SimulateRunsOnAFittedPlantModel) {
+  ASSERT_EQ(run("frf measure --plant motor-bench -o mb.csv").status, 0);
+  ASSERT_EQ(run("fit mb.csv -o mb.json").status, 0);
+  ASSERT_EQ(run("tune mb.json -o pi.json").status, 0);
+  Result r = run("simulate --controller pi.json -o step.csv");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("(--ts): the plant is a fitted model (mb.json)"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(path("step.csv")));
+  r = run("simulate --controller pi.json --ts 0.000125 --duration 2 -o step.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("pi controller on mb.json (ts = 0.000125 s"), std::string::npos) << r.out;
+  const auto model = servotwin::io::load_plant_model(path("mb.json").string()).model;
+  const auto cells = last_row(slurp(path("step.csv")));
+  EXPECT_NEAR(std::stod(cells[3]), 1.0 / model.response(0.0).real(), 1e-6);
+  EXPECT_NEAR(std::stod(cells[4]), 1.0, 1e-9);
+  // Tuned at the drive's period, the controller carries it.
+  ASSERT_EQ(run("tune mb.json --ts 0.000125 -o pid.json").status, 0);
+  r = run("simulate --controller pid.json --duration 0.5");
+  EXPECT_EQ(r.status, 0) << r.err;
 }
 
 }  // namespace

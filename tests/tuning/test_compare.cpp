@@ -5,6 +5,8 @@
 // is the tuner's own design (the same numbers as `servotwin tune --structure ...`).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <numbers>
 
@@ -46,6 +48,20 @@ TEST(CompareStructures, EachEntryIsTheTunersDesign) {
     EXPECT_LE(e.result->controller.predicted.peak_tl, 1.5 * (1.0 + 1e-3));
   }
   EXPECT_DOUBLE_EQ(relative_to_pi(c, &LoopIndices::bandwidth_load, load_bandwidth(c.front())), 1.0);
+}
+
+TEST(CompareStructures, NotesADesignWhoseLoadStepIsFarWorseThanThePis) {
+  std::vector<StructureComparison> c = compare_structures(frictionless(3.0), {});
+  EXPECT_TRUE(comparison_notes(c).empty());  // every design here rejects a load step at least as well
+  // The same comparison with the LQG's ITAE at 3.5 and at 2.9 times the PI's: noted only above 3.
+  const double pi_itae = entry(c, Structure::kPi).result->controller.predicted.itae_load_step;
+  auto& lqg = *std::find_if(c.begin(), c.end(), [](const StructureComparison& e) { return e.structure == Structure::kLqg; });
+  lqg.result->controller.predicted.itae_load_step = 3.5 * pi_itae;
+  const std::vector<std::string> notes = comparison_notes(c);
+  ASSERT_EQ(notes.size(), 1U);
+  EXPECT_EQ(notes.front().rfind("lqg: its load-step ITAE is 3.5 times the PI's", 0), 0U) << notes.front();
+  lqg.result->controller.predicted.itae_load_step = 2.9 * pi_itae;
+  EXPECT_TRUE(comparison_notes(c).empty());
 }
 
 TEST(CompareStructures, FullOrderWinsAboveRatio23AsThePrintedConclusionsSay) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sstream>
 #include <numbers>
 
 #include "fixture.hpp"
@@ -179,6 +180,26 @@ TEST(Tune, BadRequestsAreExplained) {
   tight.hf.delay_s = 0.3 / 100.0;
   const std::string m = message(two_mass_model(3.0, 0.01, 100.0, 0.01), tight);
   EXPECT_NE(m.find("best achievable"), std::string::npos) << m;
+  // Issue 25 §7: the message names the nearest limits that work, and they do.
+  const std::size_t at = m.find("--ms ", m.find("nearest limits that accept it"));
+  ASSERT_NE(at, std::string::npos) << m;
+  std::istringstream limits(m.substr(at));
+  std::string flag_ms, flag_mt;
+  TuneOptions relaxed = tight;
+  limits >> flag_ms >> relaxed.ms >> flag_mt >> relaxed.mt;
+  EXPECT_EQ(flag_mt, "--mt");
+  EXPECT_GT(relaxed.ms, tight.ms);
+  EXPECT_EQ(message(two_mass_model(3.0, 0.01, 100.0, 0.01), relaxed), "no error");
+  TuneOptions hinf_tight;
+  hinf_tight.structure = Structure::kHinf;
+  hinf_tight.ms = 1.05;
+  const std::string h = message(two_mass_model(3.0, 0.01, 100.0, 0.01), hinf_tight);
+  const std::size_t hinf_at = h.find("--ms ", h.find("nearest limits that accept it"));
+  ASSERT_NE(hinf_at, std::string::npos) << h;
+  std::istringstream hinf_limits(h.substr(hinf_at));
+  TuneOptions hinf_relaxed = hinf_tight;
+  hinf_limits >> flag_ms >> hinf_relaxed.ms >> flag_mt >> hinf_relaxed.mt;
+  EXPECT_EQ(message(two_mass_model(3.0, 0.01, 100.0, 0.01), hinf_relaxed), "no error");
   TuneOptions bad_zeta;
   bad_zeta.zeta_star = -1.0;
   EXPECT_NE(message(two_mass_model(3.0, 0.01, 100.0, 0.01), bad_zeta).find("--zeta-star"), std::string::npos);

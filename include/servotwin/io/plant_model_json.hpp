@@ -55,6 +55,10 @@ struct LoadedPlantModel {
 
 /// Reads a plant-model document; core::InputError names the source and the field ("modes[2].zeta").
 LoadedPlantModel parse_plant_model_json(std::string_view text, std::string_view source_name);
+/// True when `path` is a regular file holding a JSON object whose "format" is
+/// servotwin.plant-model/1 (false for anything else, without error: the caller then reads it as
+/// another kind and reports what is wrong with it).
+bool is_plant_model_file(const std::string& path);
 /// Opens and reads a plant-model file.
 LoadedPlantModel load_plant_model(const std::string& path);
 

@@ -41,4 +41,13 @@ struct StructureComparison {
 [[nodiscard]] double relative_to_pi(const std::vector<StructureComparison>& comparison,
                                     double LoopIndices::*index, double value);
 
+/// How much worse than the PI's a design's load-step ITAE must be for comparison_notes to say so.
+inline constexpr double kFarWorseItae = 3.0;
+
+/// Facts a reader of the comparison must not miss (issue 25 §7): each design whose load-step ITAE
+/// is more than kFarWorseItae times the PI's. The spec of C7.15 ranks by load bandwidth at equal
+/// peaks, and a design can win it with a weaker integral action: it then tracks faster and rejects
+/// a load torque slower, which the table's bandwidth column does not show.
+[[nodiscard]] std::vector<std::string> comparison_notes(const std::vector<StructureComparison>& comparison);
+
 }  // namespace servotwin::tuning
