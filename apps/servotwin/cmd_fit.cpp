@@ -43,6 +43,10 @@ void print_summary(const std::string& source, const fit::FitReport& r) {
   const fit::FitResult& f = r.result;
   const fit::PlantModel& m = f.model;
   fmt::print("{}: {} points, {} output ({})\n", source, f.points, fit::to_string(m.output), r.output.note);
+  if (!r.left_out.empty()) {
+    fmt::print("left out {} point(s) the measurement marked invalid:\n", r.left_out.size());
+    for (const std::string& why : r.left_out) fmt::print("  {}\n", why);
+  }
   fmt::print("model: {} mode(s), rigid {}{}{}; {}\n", m.modes.size(), fit::to_string(m.rigid),
              m.lag_pole_rad_s ? ", lag pole" : "", m.delay_s ? ", delay" : "", r.selection.criterion);
   if (r.selection.method == "auto")

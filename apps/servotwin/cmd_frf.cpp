@@ -325,6 +325,8 @@ void print_measurement(const std::string& plant_name, const vcnc::FrfExperiment&
   }
   const auto unsettled = std::count_if(e.points.begin(), e.points.end(), [](const frf::MeasuredPoint& p) { return !p.settled; });
   if (unsettled > 0) fmt::print("  {} point(s) latched at the settling-time limit without converging\n", unsettled);
+  for (const core::FrequencyPoint& p : e.response.points)
+    if (!p.valid) fmt::print("  invalid at {:.4g} Hz, left out of fits: {}\n", p.freq_hz, p.note);
 }
 
 int run_measure(const MeasureArgs& a, const GlobalOptions& global) {

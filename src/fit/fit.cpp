@@ -41,6 +41,10 @@ struct Data {
   [[nodiscard]] std::size_t size() const { return omega.size(); }
 };
 
+bool has_invalid(const core::FrequencyResponse& response) {
+  return std::any_of(response.points.begin(), response.points.end(), [](const auto& p) { return !p.valid; });
+}
+
 Data make_data(const core::FrequencyResponse& response) {
   Data d;
   d.known_std = std::all_of(response.points.begin(), response.points.end(), [](const auto& p) { return p.std_dev > 0.0; });
@@ -411,6 +415,7 @@ void validate_response(const core::FrequencyResponse& response) {
 }
 
 OutputDetection detect_output(const core::FrequencyResponse& response) {
+  if (has_invalid(response)) return detect_output(response.valid_only());
   OutputDetection out;
   out.detected = true;
   const auto& pts = response.points;
@@ -478,6 +483,7 @@ PhysicalExtraction two_mass_parameters(const PlantModel& model, const Eigen::Mat
 
 FitResult refine_model(const core::FrequencyResponse& response, const PlantModel& start, const FitOptions& options) {
   validate_response(response);
+  if (has_invalid(response)) return refine_model(response.valid_only(), start, options);
   const Layout l = layout_of(start);
   require_enough_points(response.size(), static_cast<std::size_t>(l.size()), "the model");
   const Data data = make_data(response);
@@ -487,6 +493,7 @@ FitResult refine_model(const core::FrequencyResponse& response, const PlantModel
 FitResult fit_model(const core::FrequencyResponse& response, std::size_t modes, OutputKind output,
                     const FitOptions& options) {
   validate_response(response);
+  if (has_invalid(response)) return fit_model(response.valid_only(), modes, output, options);
   const Layout l{modes, options.rigid, output, options.lag, options.delay};
   const std::string what = modes == 1 ? "the two-mass model" : "a model with " + std::to_string(modes) + " modes";
   require_enough_points(response.size(), static_cast<std::size_t>(l.size()), what);
@@ -568,6 +575,12 @@ std::string to_string(const ModelRequest& request) {
 
 FitReport fit_plant(const core::FrequencyResponse& response, const ModelRequest& request, const FitOptions& options) {
   validate_response(response);
+  if (has_invalid(response)) {
+    FitReport report = fit_plant(response.valid_only(), request, options);
+    for (const auto& p : response.points)
+      if (!p.valid) report.left_out.push_back(num(p.freq_hz, 6) + " Hz: " + (p.note.empty() ? "marked invalid" : p.note));
+    return report;
+  }
   FitReport report;
   report.request = request;
   if (options.output == OutputChoice::kDetect) {

@@ -194,6 +194,12 @@ BacklashEstimate estimate_backlash(const FitReport& linear, std::span<const core
 
 NonlinearMechanics analyze_nonlinear_mechanics(const FitReport& linear, std::span<const core::FrequencyResponse> experiments,
                                                const FitOptions& options) {
+  // The amplitude series measures the distortion itself: points the measurement marked invalid
+  // for their THD or SNR are its data here (the linear fit has left them out already).
+  std::vector<core::FrequencyResponse> every_point(experiments.begin(), experiments.end());
+  for (core::FrequencyResponse& r : every_point)
+    for (core::FrequencyPoint& p : r.points) p.valid = true;
+  experiments = every_point;
   NonlinearMechanics out;
   const auto& modes = linear.result.model.modes;
   const double max_freq_hz = modes.empty() ? std::numeric_limits<double>::infinity()

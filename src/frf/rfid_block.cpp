@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fmt/format.h>
 #include <numbers>
 #include <string>
 #include <utility>
@@ -13,6 +14,12 @@ namespace servotwin::frf {
 namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+/// A short message with numbers (the module has fmt; this keeps the call sites compact).
+template <typename... Args>
+std::string fmt_reason(fmt::format_string<Args...> format, Args&&... args) {
+  return fmt::format(format, std::forward<Args>(args)...);
+}
 constexpr long kHoldoffPeriods = 2;     // observer re-convergence after a start or a frequency jump (~1.25 periods)
 constexpr double kMinimumAmplitudeFraction = 0.05;  // range reduction floor, relative to A(0)
 constexpr double kSettleNoiseFraction = 0.25;  // share of the sensor noise (in output units) a settled estimate may still move per half period
@@ -397,6 +404,16 @@ core::FrequencyResponse RfidBlock::frequency_response() const {
     point.quality = m.thd;
     point.snr = m.snr;
     point.amplitude = m.amplitude;
+    const double thd_limit = p_.thd_threshold + p_.thd_hysteresis;
+    std::string why;
+    if (m.thd > thd_limit) why = fmt_reason("THD {:.3g} above {:.3g}", m.thd, thd_limit);
+    if (m.snr < kMinimumSnr) why += (why.empty() ? "" : ", ") + fmt_reason("SNR {:.3g} below {:.3g}", m.snr, kMinimumSnr);
+    if (!why.empty()) {
+      point.valid = false;
+      point.note = why + fmt_reason(" at amplitude {:.4g}", m.amplitude) +
+                   (m.amplitude_limited ? " (the amplitude could not rise: ceiling or range limit)" : "") +
+                   (m.settled ? "" : "; latched at the settling-time limit");
+    }
     if (!response.points.empty() && response.points.back().freq_hz >= point.freq_hz) response.points.back() = point;
     else response.points.push_back(point);
   }

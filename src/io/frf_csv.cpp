@@ -32,6 +32,7 @@ std::string_view trim(std::string_view s) {
 struct Preamble {
   std::optional<core::QualityKind> quality;
   std::optional<double> duration_s;
+  std::vector<std::pair<double, std::string>> invalid_notes;  // "# invalid F Hz: why"
 };
 
 void parse_comment(std::string_view line, std::size_t line_number, const std::string& source, Preamble& preamble) {
@@ -59,6 +60,12 @@ void parse_comment(std::string_view line, std::size_t line_number, const std::st
     else
       throw core::InputError({source, line_number, value_column, "quality"},
                              "unknown quality kind '" + std::string(value) + "', expected coherence or thd");
+  } else if (key.rfind("invalid ", 0) == 0 && key.size() > 11 && key.substr(key.size() - 3) == " Hz") {
+    // "# invalid 1.5 Hz: THD 0.39 above 0.07": the reason of an invalid point, matched by frequency.
+    const std::string_view freq = trim(key.substr(8, key.size() - 11));
+    const double f = detail::parse_number(Field{freq, static_cast<std::size_t>(freq.data() - line.data()) + 1},
+                                          {source, line_number, 0, "invalid"}, "invalid");
+    preamble.invalid_notes.emplace_back(f, std::string(value));
   } else if (key == "duration_s") {
     const double d = detail::parse_number(Field{value, value_column}, {source, line_number, 0, ""}, "duration_s");
     if (!(d > 0.0))
@@ -80,7 +87,7 @@ std::string column_list(const std::vector<std::string>& names) {
 
 /// Column positions of the header; npos = absent.
 struct Columns {
-  std::size_t freq, re, im, mag_db, phase_deg, quality, snr, amplitude, std_dev;
+  std::size_t freq, re, im, mag_db, phase_deg, quality, snr, amplitude, std_dev, valid;
   std::string quality_name;
   bool polar = false;
 };
@@ -117,6 +124,7 @@ Columns resolve_columns(const std::vector<std::string>& header, const std::strin
   c.snr = index_of(header, "snr");
   c.amplitude = index_of(header, "amplitude");
   c.std_dev = index_of(header, "std");
+  c.valid = index_of(header, "valid");
   return c;
 }
 
@@ -179,9 +187,19 @@ core::FrequencyResponse read_frf_csv(std::istream& in, std::string_view source_n
     p.snr = optional_field(fields, c.snr, where, "snr");
     p.amplitude = optional_field(fields, c.amplitude, where, "amplitude");
     p.std_dev = optional_field(fields, c.std_dev, where, "std");
+    if (c.valid != std::string::npos) {
+      const double v = detail::parse_number(fields[c.valid], where, "valid");
+      if (v != 0.0 && v != 1.0)
+        throw core::InputError({source, line_number, fields[c.valid].column, "valid"},
+                               fmt::format("column 'valid' must be 0 or 1, got {}", v));
+      p.valid = v == 1.0;
+    }
     response.points.push_back(p);
   }
   if (in.bad()) throw core::InputError({source, line_number, 0, ""}, "read error");
+  for (const auto& [freq, note] : preamble.invalid_notes)
+    for (core::FrequencyPoint& p : response.points)
+      if (p.freq_hz == freq && !p.valid) p.note = note;
   if (response.points.size() < options.min_points)
     throw core::InputError({source, line_number, 0, ""},
                            fmt::format("{} frequency point{}: at least {} are needed", response.points.size(),
@@ -208,19 +226,24 @@ void write_frf_csv(std::ostream& out, const core::FrequencyResponse& response, c
   for (const auto& comment : comments)
     if (comment.find_first_of("\r\n") != std::string::npos)
       throw std::invalid_argument("write_frf_csv: a comment must be a single line");
+  for (const core::FrequencyPoint& p : response.points)
+    if (p.note.find_first_of("\r\n") != std::string::npos)
+      throw std::invalid_argument("write_frf_csv: a point's note must be a single line");
   fmt::memory_buffer buffer;
   auto to = std::back_inserter(buffer);
   fmt::format_to(to, "# format: {}\n# quality: {}\n", kFormat,
                  response.quality_kind == core::QualityKind::kThd ? "thd" : "coherence");
   if (response.duration_s) fmt::format_to(to, "# duration_s: {}\n", *response.duration_s);
   for (const auto& comment : comments) fmt::format_to(to, "# {}\n", comment);
-  fmt::format_to(to, "freq_hz,re,im,mag_db,phase_deg,coherence_or_thd,snr,amplitude,std\n");
+  for (const core::FrequencyPoint& p : response.points)
+    if (!p.valid) fmt::format_to(to, "# invalid {} Hz: {}\n", p.freq_hz, p.note.empty() ? "marked invalid" : p.note);
+  fmt::format_to(to, "freq_hz,re,im,mag_db,phase_deg,coherence_or_thd,snr,amplitude,std,valid\n");
   for (const core::FrequencyPoint& p : response.points) {
     const double magnitude = std::abs(p.value);
     // A zero point has no finite dB value; its re/im columns still carry it exactly.
-    fmt::format_to(to, "{},{},{},{},{},{},{},{},{}\n", p.freq_hz, p.value.real(), p.value.imag(),
+    fmt::format_to(to, "{},{},{},{},{},{},{},{},{},{}\n", p.freq_hz, p.value.real(), p.value.imag(),
                    20.0 * std::log10(magnitude), std::arg(p.value) * 180.0 / std::numbers::pi, p.quality, p.snr,
-                   p.amplitude, p.std_dev);
+                   p.amplitude, p.std_dev, p.valid ? 1 : 0);
     detail::write_out_when_full(buffer, out);
   }
   detail::write_out(buffer, out);

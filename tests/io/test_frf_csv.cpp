@@ -55,18 +55,21 @@ TEST(FrfCsv, WritesTheDocumentedHeader) {
   const std::string text = out.str();
   EXPECT_EQ(text.substr(0, text.find("1.5,")),
             "# format: servotwin.frf/1\n# quality: coherence\n# duration_s: 19.5\n# method: test\n"
-            "freq_hz,re,im,mag_db,phase_deg,coherence_or_thd,snr,amplitude,std\n");
+            "freq_hz,re,im,mag_db,phase_deg,coherence_or_thd,snr,amplitude,std,valid\n");
   // 20·log10|0.1 − 0.2j| and arg in degrees, shortest round-trip.
   const double mag_db = 20.0 * std::log10(std::abs(std::complex<double>(0.1, -0.2)));
   const double phase = std::atan2(-0.2, 0.1) * 180.0 / std::numbers::pi;
-  EXPECT_THAT(text, HasSubstr(fmt::format("1.5,0.1,-0.2,{},{},0.99,120,0.8,0.001\n", mag_db, phase)));
+  EXPECT_THAT(text, HasSubstr(fmt::format("1.5,0.1,-0.2,{},{},0.99,120,0.8,0.001,1\n", mag_db, phase)));
 }
 
 TEST(FrfCsv, RoundTripIsExact) {
   std::ostringstream out;
   FrequencyResponse r = sample();
   r.quality_kind = QualityKind::kThd;
+  r.points[1].valid = false;  // issue 25 §1: an invalid point keeps its place and its reason
+  r.points[1].note = "THD 0.39 above 0.07: amplitude at its ceiling";
   servotwin::io::write_frf_csv(out, r);
+  EXPECT_THAT(out.str(), HasSubstr("# invalid 2.25 Hz: THD 0.39 above 0.07: amplitude at its ceiling\n"));
   const FrequencyResponse back = read(out.str());
   EXPECT_EQ(back.quality_kind, QualityKind::kThd);
   EXPECT_EQ(back.duration_s, 19.5);
@@ -78,7 +81,12 @@ TEST(FrfCsv, RoundTripIsExact) {
     EXPECT_EQ(back.points[i].snr, r.points[i].snr);
     EXPECT_EQ(back.points[i].amplitude, r.points[i].amplitude);
     EXPECT_EQ(back.points[i].std_dev, r.points[i].std_dev);
+    EXPECT_EQ(back.points[i].valid, r.points[i].valid);
+    EXPECT_EQ(back.points[i].note, r.points[i].note);
   }
+  EXPECT_EQ(back.valid_only().size(), 2u);
+  EXPECT_THAT(error_of("freq_hz,re,im,valid\n1,1,0,1\n2,1,0,0.5\n").what(),
+              HasSubstr("frf.csv:3:7 (valid): column 'valid' must be 0 or 1, got 0.5"));
 }
 
 TEST(FrfCsv, AcceptsReImOnly) {

@@ -8,6 +8,7 @@
 #include <complex>
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace servotwin::core {
@@ -20,6 +21,10 @@ struct FrequencyPoint {
   double snr = 0.0;                     ///< signal-to-noise ratio of the point (linear, not dB); 0 when unknown
   double amplitude = 0.0;               ///< excitation amplitude used for the point (input units); 0 when unknown
   double std_dev = 0.0;                 ///< standard deviation of `value` (absolute, complex circular); 0 when unknown
+  /// False when the measurement could not bring the point within its quality limits (THD, SNR):
+  /// kept for the record, left out of fits (issue 25 §1).
+  bool valid = true;
+  std::string note = {};                ///< why the point is invalid (empty when valid)
 };
 
 /// What `quality` means for a response.
@@ -32,6 +37,13 @@ struct FrequencyResponse {
   std::optional<double> duration_s;     ///< how long the experiment took [s], when known
 
   [[nodiscard]] std::size_t size() const noexcept { return points.size(); }
+  /// The same response without its invalid points.
+  [[nodiscard]] FrequencyResponse valid_only() const {
+    FrequencyResponse out{{}, quality_kind, duration_s};
+    for (const FrequencyPoint& p : points)
+      if (p.valid) out.points.push_back(p);
+    return out;
+  }
 };
 
 }  // namespace servotwin::core

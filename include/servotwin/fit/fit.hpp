@@ -153,6 +153,9 @@ struct FitReport {
   Selection selection;
   OutputDetection output;
   ModelRequest request;
+  /// Points marked invalid by the measurement (FrequencyPoint::valid, issue 25 §1) and left out
+  /// of the fit: "1 Hz: THD 0.39 above 0.07 ...", in frequency order.
+  std::vector<std::string> left_out;
 };
 
 /// Automatic order selection (kAuto) tries n = 0 .. min(max_modes, resonances found by peak
@@ -164,6 +167,10 @@ struct FitReport {
 /// when the chosen fit does not converge (the message names the model and the LM status).
 FitReport fit_plant(const core::FrequencyResponse& response, const ModelRequest& request,
                     const FitOptions& options = {});
+
+/// Every fitting entry point (fit_plant, fit_model, refine_model, detect_output) uses only the
+/// points marked valid; a response with fewer valid points than the model needs is refused as
+/// too short.
 
 /// Validates a response for fitting: at least one point, finite positive strictly increasing
 /// frequencies, finite non-zero values, finite non-negative std_dev. core::InputError names the

@@ -86,7 +86,8 @@ BacklashEstimate estimate_backlash(const FitReport& linear, std::span<const core
                                    const FitOptions& options);
 
 /// Both, for `servotwin fit --amplitude-series`: `experiments` holds every measurement (the one
-/// `linear` was fitted to included).
+/// `linear` was fitted to included). Every point is used, including those the measurement marked
+/// invalid (FrequencyPoint::valid): their distortion is what the series measures.
 NonlinearMechanics analyze_nonlinear_mechanics(const FitReport& linear, std::span<const core::FrequencyResponse> experiments,
                                                const FitOptions& options);
 

@@ -123,7 +123,13 @@ class RfidBlock {
   [[nodiscard]] std::span<const MeasuredPoint> points() const noexcept { return points_; }
   /// The latched points as a response (sorted by frequency; a repeated frequency keeps the later
   /// point), quality = THD, with the run's duration. Allocates; not for the per-sample path.
+  /// A point is invalid (FrequencyPoint::valid, issue 25 §1) when the amplitude adaptation could
+  /// not bring it within its limits: THD above THD* + h at the latch (friction, backlash or noise
+  /// still dominating the response), or SNR below kMinimumSnr; the note says which and whether
+  /// the amplitude was held by its ceiling or the range protection.
   [[nodiscard]] core::FrequencyResponse frequency_response() const;
+  /// Fewest A1/noise a valid point has: at 3 the noise moves the phase by up to 19°.
+  static constexpr double kMinimumSnr = 3.0;
   /// Seconds since the start edge (frozen when the run ends).
   [[nodiscard]] double elapsed_s() const noexcept { return static_cast<double>(run_samples_) * p_.ts; }
   [[nodiscard]] const RfidParameters& parameters() const noexcept { return p_; }
