@@ -55,6 +55,7 @@ void print_summary(const std::string& source, const fit::FitReport& r) {
                  c.converged ? (c.modes == r.selection.chosen ? "  <- chosen" : "") : "  (did not converge)");
   fmt::print("fit: {} iterations from the {} start, {}; rms log error {:.3g} ({} weighting)\n", f.iterations,
              f.initialization, f.message, f.rms_log_error, f.weighting);
+  if (!f.uncertainty_note.empty()) fmt::print("  ({})\n", f.uncertainty_note);
   fmt::print("  gain K          = {}\n", pm(f.gain.value, f.gain.std));
   if (m.rigid == fit::RigidKind::kRealPole)
     fmt::print("  rigid pole      = {} Hz\n", pm(f.rigid_pole_rad_s.value / kTwoPi, f.rigid_pole_rad_s.std / kTwoPi));

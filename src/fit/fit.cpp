@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <fmt/format.h>
 #include <limits>
 #include <numbers>
 #include <numeric>
@@ -312,10 +313,41 @@ Estimate log_estimate(const Eigen::VectorXd& t, const Eigen::MatrixXd& c, Eigen:
   return {v, std::abs(v) * std::sqrt(c(i, i))};
 }
 
+/// The covariance factor of FitResult::uncertainty_scale, with its note.
+std::pair<double, std::string> misfit_scale(const Run& run, const Layout& l, const Data& data) {
+  const std::size_t m = data.size();
+  const double dof = 2.0 * static_cast<double>(m) - static_cast<double>(l.size());
+  Eigen::VectorXd r(static_cast<Eigen::Index>(2 * m));
+  if (dof <= 0.0 || m < 3 || !log_residuals(run.theta, l, run.sign, data, r, nullptr)) return {1.0, {}};
+  double lag0 = 0.0, lag1 = 0.0;
+  for (Eigen::Index k = 0; k < r.size(); ++k) {
+    lag0 += r[k] * r[k];
+    if (k + 2 < r.size()) lag1 += r[k] * r[k + 2];  // the same part (Re or Im) of the next point
+  }
+  const double rho = lag0 > 0.0 ? std::clamp(lag1 / lag0, 0.0, 0.98) : 0.0;
+  const double kappa = (1.0 + rho) / (1.0 - rho);
+  const bool correlated = rho > 2.0 / std::sqrt(static_cast<double>(m));
+  if (data.known_std) {
+    const double s = r.squaredNorm() / dof;
+    if (!(s > 1.0 + 3.0 * std::sqrt(2.0 / dof))) return {1.0, {}};
+    return {s * kappa, fmt::format("standard deviations scaled by {:.3g}: the misfit is {:.3g} times the measured "
+                                   "noise (reduced chi-square {:.3g}) and neighbouring residuals correlate "
+                                   "(rho {:.2f}), so the noise alone would understate them",
+                                   std::sqrt(s * kappa), std::sqrt(s), s, rho)};
+  }
+  if (!correlated) return {1.0, {}};
+  return {kappa, fmt::format("standard deviations scaled by {:.3g}: neighbouring residuals correlate (rho {:.2f}), a "
+                             "systematic misfit",
+                             std::sqrt(kappa), rho)};
+}
+
 FitResult finish(const Run& run, const Layout& l, const Data& data) {
   FitResult f;
   Eigen::VectorXd t = run.theta;
-  Eigen::MatrixXd c = run.lm.covariance;
+  const auto [scale, note] = misfit_scale(run, l, data);
+  Eigen::MatrixXd c = run.lm.covariance * scale;
+  f.uncertainty_scale = scale;
+  f.uncertainty_note = note;
   canonicalize(t, c, l);
   f.model = to_model(t, l, run.sign);
   f.converged = run.lm.converged();

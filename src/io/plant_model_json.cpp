@@ -122,6 +122,7 @@ json plant_model_to_json(const fit::FitReport& report, const fit::NonlinearMecha
        {{"converged", f.converged}, {"message", f.message}, {"initialization", f.initialization},
         {"weighting", f.weighting}, {"points", f.points}, {"parameters", f.parameters}, {"iterations", f.iterations},
         {"cost", f.cost}, {"residual", f.rms_log_error}, {"sigma2", number_or_null(f.sigma2)},
+        {"uncertainty_scale", f.uncertainty_scale}, {"uncertainty_note", f.uncertainty_note},
         {"left_out", report.left_out}}},
       {"selection",
        {{"method", report.selection.method},

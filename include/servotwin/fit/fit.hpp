@@ -98,6 +98,16 @@ struct FitResult {
   double cost = 0.0;                  ///< ½ Σ |e_l|² at the solution
   double rms_log_error = 0.0;         ///< sqrt(Σ|ln(P_model/P_meas)|²/m), unweighted (0.01 ≈ 1 %)
   double sigma2 = 0.0;                ///< residual variance used for the covariance (1 when std_dev given)
+  /// Factor the covariance was multiplied by so that the standard deviations reflect the misfit
+  /// (issue 25 §2; 1 = the covariance of the noise alone). Rule: with measured std_dev, when the
+  /// reduced χ² s = ‖r‖²/(2m − p) exceeds the noise level (s > 1 + 3·sqrt(2/(2m − p))), the model
+  /// error dominates: factor = s·κ; without std_dev (the covariance already scaled by s), factor =
+  /// κ when the residuals are significantly correlated (ρ1 > 2/sqrt(m)); else 1. κ = (1 + ρ1)/
+  /// (1 − ρ1), ρ1 in [0, 0.98] the lag-one autocorrelation of the residuals along frequency: a
+  /// smooth, systematic misfit leaves fewer independent residuals than points (the effective
+  /// sample size of an AR(1) sequence, m(1 − ρ1)/(1 + ρ1)).
+  double uncertainty_scale = 1.0;
+  std::string uncertainty_note;       ///< why the factor is not 1 (empty when it is)
   std::vector<std::string> parameter_names;  ///< names of θ ("ln_gain", "ln_rigid_pole", "mode1.ln_wz", ...)
   Eigen::VectorXd theta;
   Eigen::MatrixXd covariance;         ///< covariance of θ (NaN where not identifiable)
