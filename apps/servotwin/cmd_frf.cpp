@@ -20,6 +20,7 @@
 #include "servotwin/frf/offline.hpp"
 #include "servotwin/io/excitation_csv.hpp"
 #include "servotwin/io/frf_csv.hpp"
+#include "servotwin/io/controller_json.hpp"
 #include "servotwin/io/plant_json.hpp"
 #include "servotwin/io/signal_csv.hpp"
 #include "servotwin/machine/flexible_presets.hpp"
@@ -289,6 +290,7 @@ struct MeasureArgs {
   double thd = 0.05;
   double max_time = 0.0;
   bool open_loop = false;
+  std::string controller;  // closed loop: the velocity controller the block runs inside
   std::string out;
   std::string trace;
 };
@@ -343,20 +345,42 @@ int run_measure(const MeasureArgs& a, const GlobalOptions& global) {
   settings.thd_threshold = a.thd;
   settings.max_time_s = a.max_time;
   settings.hold_dc = !a.open_loop;
-  const frf::RfidParameters parameters = vcnc::experiment_parameters(plant, settings);
-  const double dc_gain = vcnc::dc_hold_gain(plant, settings);
+  const bool closed = !a.controller.empty();
+  std::optional<core::DiscreteStateSpace> controller;
+  if (closed) {
+    const io::LoadedController loaded = io::load_controller(a.controller);
+    try {
+      controller = tuning::discretize_controller(loaded.controller, plant.ts());
+    } catch (const core::InputError& e) {
+      throw core::InputError({a.controller, 0, 0, e.where().field}, e.reason());
+    }
+  }
+  const frf::RfidParameters parameters =
+      closed ? vcnc::closed_loop_parameters(plant, settings) : vcnc::experiment_parameters(plant, settings);
+  const double dc_gain = closed ? 0.0 : vcnc::dc_hold_gain(plant, settings);
   // Outputs are opened before the run, so an existing file stops the command before the work.
   auto out = open_output(a.out, global);
   auto trace_out = a.trace.empty() ? nullptr : open_output(a.trace, global);
   progress(global, "{}: {} to {} Hz, {} listed points, start amplitude {:.4g}, limit {:.4g}, output range +-{:.4g}{}",
            config.name.empty() ? a.plant : config.name, settings.f_begin_hz, settings.f_end_hz, settings.points,
            parameters.initial_amplitude, parameters.max_amplitude, parameters.output_max,
-           dc_gain > 0.0 ? fmt::format(", semi-closed loop (gain {:.3g})", dc_gain) : std::string(", open loop"));
+           closed            ? ", inside the velocity loop of " + a.controller
+           : dc_gain > 0.0   ? fmt::format(", semi-closed loop (gain {:.3g})", dc_gain)
+                             : std::string(", open loop"));
   const auto report = [&](double t, std::size_t points, double f_hz) {
     if (t >= 1.0 && std::fmod(t, 5.0) < 1.0) progress(global, "  t = {:.0f} s: {} points, at {:.1f} Hz", t, points, f_hz);
   };
-  const vcnc::FrfExperiment e =
-      vcnc::run_frf_experiment(plant, parameters, vcnc::time_limit(settings), trace_out != nullptr, dc_gain, report);
+  vcnc::FrfExperiment e;
+  if (closed) {
+    try {
+      e = vcnc::run_frf_experiment_closed_loop(plant, parameters, vcnc::time_limit(settings), *controller,
+                                               trace_out != nullptr, report);
+    } catch (const core::InputError& error) {
+      throw core::InputError({a.controller, 0, 0, "controller"}, error.reason());
+    }
+  } else {
+    e = vcnc::run_frf_experiment(plant, parameters, vcnc::time_limit(settings), trace_out != nullptr, dc_gain, report);
+  }
   print_measurement(config.name.empty() ? a.plant : config.name, e);
   if (e.response.points.size() < 2)
     throw core::InputError(core::at_field(a.plant), "the experiment " + vcnc::outcome_text(e) + " with fewer than 2 points");
@@ -364,6 +388,9 @@ int run_measure(const MeasureArgs& a, const GlobalOptions& global) {
       "source: frf measure --plant " + a.plant,
       fmt::format("method: swept sine + harmonic observer (real-time block), {}, ts {} s", vcnc::outcome_text(e), plant.ts()),
       "note: the response is that of the sampled plant (zero-order hold included)"};
+  if (closed)
+    comments.push_back("closed loop: the block excited the velocity reference of " + a.controller +
+                       "; P = T/(C_r + T C_y) from the measured T = y/reference and the controller's responses");
   io::write_frf_csv(out->stream(), e.response, comments);
   out->commit();
   if (trace_out) {
@@ -395,6 +422,10 @@ void add_measure(CLI::App& frf, Action& selected) {
                   "Stop the simulation after this much experiment time [s] (default: max(120 s, 200 periods of the "
                   "first frequency + 4 sweep times))");
   cmd->add_flag("--open-loop", a->open_loop, "No semi-closed loop on the DC estimate (velocity outputs)");
+  cmd->add_option("--controller", a->controller,
+                  "Run the block inside this velocity loop (servotwin.controller/1): it excites the reference, and "
+                  "the plant follows from the measured closed loop and the controller (indirect method)")
+      ->check(CLI::ExistingFile);
   add_output_file_option(*cmd, a->out, "Frequency-response CSV to write ('-' = stdout)")->required();
   cmd->add_option("--trace", a->trace, "Also write every sample (t, mv, pv, f_hz, amplitude, thd, state) as CSV");
   set_examples(*cmd,

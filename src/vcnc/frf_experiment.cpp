@@ -118,6 +118,16 @@ frf::RfidParameters experiment_parameters(const machine::FlexiblePlant& plant, c
   return p;
 }
 
+frf::RfidParameters closed_loop_parameters(const machine::FlexiblePlant& plant, const FrfExperimentSettings& settings) {
+  frf::RfidParameters p = experiment_parameters(plant, settings);
+  p.initial_amplitude = settings.amplitude.value_or(300.0 * noise_floor(plant.config().settings));
+  p.max_amplitude = std::max(settings.max_amplitude.value_or(100.0 * p.initial_amplitude), p.initial_amplitude);
+  const double limit = settings.output_limit.value_or(3.0 * p.max_amplitude);
+  p.output_min = -limit;
+  p.output_max = limit;
+  return p;
+}
+
 double dc_hold_gain(const machine::FlexiblePlant& plant, const FrfExperimentSettings& settings) {
   const machine::PlantOutput output = plant.config().settings.output;
   const bool velocity = output == machine::PlantOutput::MotorVelocity || output == machine::PlantOutput::LoadVelocity;

@@ -84,3 +84,23 @@ TEST_F(Cli, FitWithAnAmplitudeSeriesReportsFrictionAndBacklash) {
 
 }  // namespace
 }  // namespace servotwin::cli_test
+
+namespace servotwin::cli_test {
+namespace {
+
+// Issue 25 §3: the block inside the tuned velocity loop; the accuracy against the sampled plant
+// is checked in tests/vcnc/test_frf_experiment.cpp, here the command and its file.
+TEST_F(Cli, FrfMeasureInsideAVelocityLoop) {
+  ASSERT_EQ(run("tune motor-bench --ts 0.000125 -o pi.json").status, 0);
+  const Result r = run("frf measure --plant motor-bench --controller pi.json -o cl.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("inside the velocity loop of pi.json"), std::string::npos) << r.err;
+  EXPECT_NE(slurp(path("cl.csv")).find("# closed loop: the block excited the velocity reference of pi.json"),
+            std::string::npos);
+  EXPECT_EQ(run("fit cl.csv -o cl.json").status, 0);
+  const Result missing = run("frf measure --plant motor-bench --controller nope.json -o x.csv");
+  EXPECT_EQ(missing.status, 2);  // not an existing file: a usage error
+}
+
+}  // namespace
+}  // namespace servotwin::cli_test

@@ -183,3 +183,57 @@ TEST(FrfExperiment, PointsOutsideTheirLimitsAreMarkedAndLeftOutOfTheFit) {
 
 }  // namespace
 }  // namespace servotwin
+
+#include "servotwin/core/state_space.hpp"
+#include "servotwin/fit/plant_model.hpp"
+#include "servotwin/tuning/tune.hpp"
+
+namespace servotwin {
+namespace {
+
+// Issue 25 §3: the block inside a velocity loop. The plant: the motor bench's linear mechanics
+// (no friction, no quantization, noise 0.001 rad/s); the controller: the tuner's PI for it,
+// Tustin at the plant's 8 kHz. Reference: the exact ZOH-sampled plant P_d(e^{jωts})
+// (core::discretize_zoh of its transfer function), what the open-loop measurement also returns.
+TEST(FrfExperiment, InsideAVelocityLoopTheBlockRecoversThePlant) {
+  machine::PlantConfig config = machine::flexible_preset("motor-bench");
+  std::get<machine::MassChain>(config.model).friction.clear();
+  config.settings.quantization = 0.0;
+  config.settings.noise_std = 0.001;
+  machine::FlexiblePlant plant(config);
+  const core::TransferFunction tf = plant.transfer_function();
+  const fit::PlantModel model = fit::plant_model_from_transfer_function(tf);
+  const tuning::TuneResult pi = tuning::tune(model, {});
+  const core::DiscreteStateSpace controller = tuning::discretize_controller(pi.controller, plant.ts());
+  vcnc::FrfExperimentSettings settings;
+  const auto e = vcnc::run_frf_experiment_closed_loop(plant, vcnc::closed_loop_parameters(plant, settings),
+                                                      vcnc::time_limit(settings), controller, false);
+  ASSERT_EQ(e.final_state, frf::RfidState::kDone) << vcnc::outcome_text(e);
+  const core::DiscreteStateSpace sampled = core::discretize_zoh(core::to_state_space(tf), plant.ts());
+  std::size_t compared = 0;
+  for (const auto& p : e.response.points) {
+    const double w = kTwoPi * p.freq_hz;
+    const std::complex<double> truth = core::frequency_response(sampled, w)(0, 0);
+    const std::complex<double> c_y = core::frequency_response(controller, w)(0, 1);
+    if (std::abs(1.0 / (1.0 - truth * c_y)) < 0.1 || !p.valid) continue;
+    ++compared;
+    EXPECT_LT(std::abs(20.0 * std::log10(std::abs(p.value / truth))), 1.0) << p.freq_hz << " Hz";
+    EXPECT_LT(std::abs(std::arg(p.value / truth)) * 180.0 / std::numbers::pi, 5.0) << p.freq_hz << " Hz";
+  }
+  EXPECT_GE(compared, 20u);  // of 32: below about 8 Hz the PI makes |S| < 0.1
+
+  // A controller that destabilizes the loop is refused before the run.
+  core::DiscreteStateSpace wild = controller;
+  wild.C *= 1e4;
+  wild.D *= 1e4;
+  try {
+    (void)vcnc::run_frf_experiment_closed_loop(plant, vcnc::closed_loop_parameters(plant, settings), 1.0, wild, false);
+    ADD_FAILURE() << "no error";
+  } catch (const core::InputError& err) {
+    EXPECT_EQ(err.where().field, "controller");
+    EXPECT_THAT(err.reason(), ::testing::HasSubstr("unstable"));
+  }
+}
+
+}  // namespace
+}  // namespace servotwin

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "servotwin/core/frequency_response.hpp"
+#include "servotwin/core/state_space.hpp"
 #include "servotwin/frf/rfid_block.hpp"
 #include "servotwin/machine/flexible_plant.hpp"
 
@@ -81,6 +82,12 @@ frf::RfidParameters experiment_parameters(const machine::FlexiblePlant& plant, c
 /// Progress callback: (experiment time [s], points latched so far, current frequency [Hz]).
 using FrfProgress = std::function<void(double, std::size_t, double)>;
 
+/// experiment_parameters for the block inside a velocity loop: its signal is the reference, which
+/// the loop follows with |T| close to 1 in its band, so the start amplitude is 300 × the noise
+/// floor (or settings.amplitude), the ceiling 100 × that, and the output range 3 × the ceiling
+/// (or settings.output_limit).
+frf::RfidParameters closed_loop_parameters(const machine::FlexiblePlant& plant, const FrfExperimentSettings& settings);
+
 /// The sweep time and the time limit with their automatic values resolved (see the settings).
 double sweep_time(const FrfExperimentSettings& settings);
 double time_limit(const FrfExperimentSettings& settings);
@@ -96,6 +103,19 @@ double dc_hold_gain(const machine::FlexiblePlant& plant, const FrfExperimentSett
 FrfExperiment run_frf_experiment(machine::FlexiblePlant& plant, const frf::RfidParameters& parameters,
                                  double max_time_s, bool keep_trace, double dc_gain = 0.0,
                                  const FrfProgress& progress = {});
+
+/// The block inside a velocity loop (issue 25 §3): its excitation is the velocity reference ω*,
+/// `controller` (discrete at the plant's period, inputs [ω*, y], output the torque command) drives
+/// the plant, and the block measures the closed loop T = y/ω*. Each point becomes the plant's
+/// response P = T/(C_r + T·C_y), with C_r and C_y the controller's responses at e^{jωts} (the
+/// indirect method with a known controller, Ljung 1999 §13.5: u = C_r ω* + C_y y and y = P u);
+/// its THD and SNR are those of the measured T. No semi-closed loop: the loop holds the mean.
+/// core::InputError naming "controller" when it does not have two inputs and one output, its
+/// period differs from the plant's, the plant does not measure a velocity, or the discrete loop
+/// of the plant's linear part and the controller is unstable (the largest |z| named).
+FrfExperiment run_frf_experiment_closed_loop(machine::FlexiblePlant& plant, const frf::RfidParameters& parameters,
+                                             double max_time_s, const core::DiscreteStateSpace& controller,
+                                             bool keep_trace, const FrfProgress& progress = {});
 
 /// "listed", "resonance", "antiresonance".
 std::string point_kind_name(frf::PointKind kind);
