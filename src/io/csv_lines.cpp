@@ -120,4 +120,10 @@ double parse_number(const Field& field, core::SourceLocation where, std::string_
   return value;
 }
 
+std::string_view trim_blanks(std::string_view s) noexcept {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
 }  // namespace servotwin::io::detail

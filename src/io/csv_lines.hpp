@@ -26,6 +26,10 @@ void split_csv_line(std::string_view line, std::vector<Field>& fields, char deli
 /// make no empty fields (halsampler ends every value with a blank).
 void split_blank_separated(std::string_view line, std::vector<Field>& fields);
 
+/// `s` without leading blanks and tabs and trailing blanks, tabs and carriage returns (for the
+/// `# key: value` comments the readers take settings from).
+std::string_view trim_blanks(std::string_view s) noexcept;
+
 /// ASCII lower case (column names are matched case-insensitively).
 std::string lower(std::string_view s);
 

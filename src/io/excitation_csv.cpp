@@ -22,11 +22,7 @@ namespace {
 
 constexpr std::string_view kFormat = "servotwin.excitation/1";
 
-std::string_view trim_blanks(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
+using detail::trim_blanks;
 
 /// A `# key: value` comment with where its value starts.
 struct Entry {

@@ -22,11 +22,7 @@ using detail::Field;
 
 constexpr std::string_view kFormat = "servotwin.frf/1";
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
+using detail::trim_blanks;
 
 /// Settings found in `# key: value` comments before the header.
 struct Preamble {
@@ -36,13 +32,13 @@ struct Preamble {
 };
 
 void parse_comment(std::string_view line, std::size_t line_number, const std::string& source, Preamble& preamble) {
-  std::string_view body = trim(line);
+  std::string_view body = trim_blanks(line);
   if (body.empty() || body.front() != '#') return;
-  body = trim(body.substr(1));
+  body = trim_blanks(body.substr(1));
   const std::size_t colon = body.find(':');
   if (colon == std::string_view::npos) return;
-  const std::string_view key = trim(body.substr(0, colon));
-  const std::string_view value = trim(body.substr(colon + 1));
+  const std::string_view key = trim_blanks(body.substr(0, colon));
+  const std::string_view value = trim_blanks(body.substr(colon + 1));
   const std::size_t value_column = static_cast<std::size_t>(value.data() - line.data()) + 1;
   if (key == "format") {
     const std::size_t slash = value.rfind('/');
@@ -62,7 +58,7 @@ void parse_comment(std::string_view line, std::size_t line_number, const std::st
                              "unknown quality kind '" + std::string(value) + "', expected coherence or thd");
   } else if (key.rfind("invalid ", 0) == 0 && key.size() > 11 && key.substr(key.size() - 3) == " Hz") {
     // "# invalid 1.5 Hz: THD 0.39 above 0.07": the reason of an invalid point, matched by frequency.
-    const std::string_view freq = trim(key.substr(8, key.size() - 11));
+    const std::string_view freq = trim_blanks(key.substr(8, key.size() - 11));
     const double f = detail::parse_number(Field{freq, static_cast<std::size_t>(freq.data() - line.data()) + 1},
                                           {source, line_number, 0, "invalid"}, "invalid");
     preamble.invalid_notes.emplace_back(f, std::string(value));

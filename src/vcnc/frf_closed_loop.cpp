@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <numbers>
 
+#include "frf_run.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/vcnc/frf_experiment.hpp"
 
@@ -109,12 +110,7 @@ FrfExperiment run_frf_experiment_closed_loop(machine::FlexiblePlant& plant, cons
     y = plant.step(loop.step(o.mv, y)).y;
     if (progress && k % report_every == 0) progress(static_cast<double>(k) * ts, block.points().size(), o.omega / kTwoPi);
   }
-  out.timed_out = k >= max_samples;
-  out.final_state = block.state();
-  out.abort_reason = block.abort_reason();
-  out.points.assign(block.points().begin(), block.points().end());
-  out.response = block.frequency_response();
-  out.response.duration_s = block.elapsed_s();
+  detail::collect_results(block, k >= max_samples, out);
   // T -> P with the controller's own responses (the block measured y over its reference).
   for (core::FrequencyPoint& p : out.response.points) {
     const Eigen::MatrixXcd c = core::frequency_response(controller, kTwoPi * p.freq_hz);

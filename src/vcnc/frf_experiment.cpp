@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "frf_run.hpp"
 #include "servotwin/core/error.hpp"
 
 namespace servotwin::vcnc {
@@ -169,12 +170,7 @@ FrfExperiment run_frf_experiment(machine::FlexiblePlant& plant, const frf::RfidP
     pv = plant.step(o.mv).y;
     if (progress && k % report_every == 0) progress(static_cast<double>(k) * ts, block.points().size(), o.omega / kTwoPi);
   }
-  out.timed_out = k >= max_samples;
-  out.final_state = block.state();
-  out.abort_reason = block.abort_reason();
-  out.points.assign(block.points().begin(), block.points().end());
-  out.response = block.frequency_response();
-  out.response.duration_s = block.elapsed_s();
+  detail::collect_results(block, k >= max_samples, out);
   return out;
 }
 
