@@ -61,13 +61,19 @@ frf::Detrend detrend_of(const std::string& text, frf::Detrend fallback) {
   return fallback;
 }
 
+/// "skip_periods" -> "skip-periods": the library's field as the option the user typed.
+std::string dashed(std::string field) {
+  std::replace(field.begin(), field.end(), '_', '-');
+  return field;
+}
+
 /// Estimator errors name an option or a signal; say which file and column they concern.
 [[noreturn]] void rethrow_located(const core::InputError& e, const EstimateArgs& a) {
   const std::string& field = e.where().field;
   std::string where = field == "input"       ? a.input
                       : field == "output"    ? a.response
                       : field == "reference" ? a.reference
-                                             : "--" + field;
+                                             : "--" + dashed(field);
   throw core::InputError({a.data, 0, 0, where}, e.reason());
 }
 
@@ -221,7 +227,7 @@ void add_estimate(CLI::App& frf, Action& selected) {
                                "The record was taken inside a closed loop whose reference was excited: estimate the "
                                "plant (input -> response) by the indirect method P = S_ry/S_ru (needs --reference)");
   cmd->add_option("--reference", a->reference, "Closed loop: the column of the excited reference")->needs(closed);
-  cmd->add_option("--excitation", a->excitation,
+  CLI::Option* excitation = cmd->add_option("--excitation", a->excitation,
                   "Excitation CSV the drive played (servotwin frf excitation): the recording is aligned with it and "
                   "estimated as its type allows (per-period DFT, H1 of a single sweep, or one line per sine step)")
       ->check(CLI::ExistingFile);
@@ -263,6 +269,11 @@ void add_estimate(CLI::App& frf, Action& selected) {
                   "through the period means for multisine)")
       ->check(CLI::IsMember({"auto", "none", "mean", "linear"}))
       ->capture_default_str();
+  // The design decides the estimator: options that choose or tune another one would be ignored,
+  // and --closed-loop would be the biased open-loop estimate of a single sweep.
+  for (const char* name : {"--closed-loop", "--method", "--segment", "--overlap", "--window", "--periods", "--period",
+                           "--excitation-threshold-db"})
+    excitation->excludes(cmd->get_option(name));
   set_examples(*cmd,
                "  servotwin frf estimate MultisineTypeA.csv --input iq_adx --response theta_mx --method multisine "
                "--periods 20 --skip-periods 1 -o frf.csv\n"

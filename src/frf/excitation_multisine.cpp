@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <fmt/format.h>
 #include <numbers>
 #include <vector>
@@ -25,7 +26,8 @@ struct Period {
 
 /// Periods and their length: with `periods` given, the longest period that fits that many times;
 /// otherwise the shortest period whose line spacing reaches f_begin_hz, repeated as often as the
-/// duration allows (averaging over periods is what gives each point its noise estimate).
+/// duration allows (averaging over periods is what gives each point its noise estimate). Period
+/// lengths have no prime factor above 5.
 Period choose_period(const ExcitationRequest& r) {
   const double total = std::floor(r.duration_s / r.ts + 1e-9);
   Period p;
@@ -36,7 +38,8 @@ Period choose_period(const ExcitationRequest& r) {
                              "as transient)");
     p.count = r.periods;
   } else {
-    const double shortest = std::ceil(1.0 / (r.f_begin_hz * r.ts) - 1e-9);
+    const auto shortest = static_cast<double>(
+        detail::smallest_fast_length(static_cast<std::size_t>(std::ceil(1.0 / (r.f_begin_hz * r.ts) - 1e-9))));
     p.count = static_cast<std::size_t>(std::floor(total / shortest));
     if (p.count < 2)
       throw core::InputError(core::at_field("duration_s"),
@@ -44,7 +47,15 @@ Period choose_period(const ExcitationRequest& r) {
                                          "at {} s per sample); give at least {} s or a higher range begin",
                                          r.duration_s, shortest, r.f_begin_hz, r.ts, 2.0 * shortest * r.ts));
   }
-  p.samples = static_cast<std::size_t>(std::floor(total / static_cast<double>(p.count)));
+  p.samples = detail::largest_fast_length(static_cast<std::size_t>(std::floor(total / static_cast<double>(p.count))));
+  const double df = p.samples == 0 ? std::numeric_limits<double>::infinity()
+                                   : 1.0 / (static_cast<double>(p.samples) * r.ts);
+  if (df > r.f_begin_hz * (1.0 + 1e-9))
+    throw core::InputError(core::at_field(r.periods > 0 ? "periods" : "duration_s"),
+                           fmt::format("{} periods of {} samples space the lines {:.4g} Hz apart, coarser than the "
+                                       "range's begin {} Hz; use at most {:.0f} periods or a longer duration",
+                                       p.count, p.samples, df, r.f_begin_hz,
+                                       std::floor(total * r.ts * r.f_begin_hz + 1e-9)));
   return p;
 }
 

@@ -51,6 +51,13 @@ Excitation design_sine_steps(const ExcitationRequest& r) {
     SineStep s;
     // The nearest line, kept inside the requested range.
     const double lowest = std::ceil(r.f_begin_hz * window_s - 1e-9), highest = std::floor(r.f_end_hz * window_s + 1e-9);
+    if (lowest + static_cast<double>(count) - 1.0 > highest)
+      throw core::InputError(core::at_field(r.steps > 0 ? "steps" : "duration_s"),
+                             fmt::format("windows of {:.4g} s hold only {:.0f} distinct frequencies in {} ... {} Hz "
+                                         "(lines {:.4g} Hz apart), fewer than {} steps; use fewer steps or a longer "
+                                         "duration",
+                                         window_s, std::max(0.0, highest - lowest + 1.0), r.f_begin_hz, r.f_end_hz,
+                                         1.0 / window_s, count));
     s.cycles = static_cast<std::size_t>(std::max(kMinCycles, std::clamp(std::round(wanted * window_s), lowest, highest)));
     // Below the window's Nyquist line: f_end < 1/(2 ts) keeps cycles < window/2 but rounding up
     // could reach it.

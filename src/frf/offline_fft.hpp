@@ -3,12 +3,40 @@
 // mixed radix 2/3/4/5 plus a generic butterfly, so any length works; lengths with a large prime
 // factor are slower, O(N·p)).
 
+#include <algorithm>
 #include <complex>
 #include <cstddef>
 #include <unsupported/Eigen/FFT>
 #include <vector>
 
 namespace servotwin::frf::detail {
+
+/// The largest length <= n with no prime factor above 5 (the FFT's fast radices; the swapping
+/// iteration runs hundreds of FFTs of the period, and a large prime factor would make each
+/// O(N·p)). At most 6.7 % shorter than n for n >= 50.
+inline std::size_t largest_fast_length(std::size_t n) {
+  std::size_t best = 0;
+  for (std::size_t p5 = 1; p5 <= n; p5 *= 5)
+    for (std::size_t p35 = p5; p35 <= n; p35 *= 3) {
+      std::size_t candidate = p35;
+      while (candidate * 2 <= n) candidate *= 2;
+      best = std::max(best, candidate);
+    }
+  return best;
+}
+
+/// The smallest length >= n with no prime factor above 5.
+inline std::size_t smallest_fast_length(std::size_t n) {
+  std::size_t best = 1;
+  while (best < n) best *= 2;
+  for (std::size_t p5 = 1; p5 < best; p5 *= 5)
+    for (std::size_t p35 = p5; p35 < best; p35 *= 3) {
+      std::size_t candidate = p35;
+      while (candidate < n) candidate *= 2;
+      best = std::min(best, candidate);
+    }
+  return best;
+}
 
 /// Computes X(k) = Σ x[n] e^{−j2πkn/N}, k = 0 … N/2, reusing its plan and buffers across calls
 /// of the same length.

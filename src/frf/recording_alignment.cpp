@@ -20,24 +20,10 @@ namespace {
 // position) stays well below it (0.73 for the resonance of the tests).
 constexpr double kLeastCorrelation = 0.9;
 
-/// The smallest length >= n with no prime factor above 5 (kissfft's fast radices): zero padding to
-/// it instead of the next power of two halves the work when n lies just above a power.
-std::size_t fast_fft_length(std::size_t n) {
-  std::size_t best = 1;
-  while (best < n) best *= 2;
-  for (std::size_t p5 = 1; p5 < best; p5 *= 5)
-    for (std::size_t p35 = p5; p35 < best; p35 *= 3) {
-      std::size_t candidate = p35;
-      while (candidate < n) candidate *= 2;
-      best = std::min(best, candidate);
-    }
-  return best;
-}
-
 /// Linear (not circular) correlation sums c(d) = Σ_n a[n + d] b[n] for d = −(nb − 1) … na − 1,
 /// returned at index d + nb − 1, through zero-padded FFTs.
 std::vector<double> correlate(std::span<const double> a, std::span<const double> b) {
-  const std::size_t length = fast_fft_length(a.size() + b.size());
+  const std::size_t length = detail::smallest_fast_length(a.size() + b.size());
   detail::RealDft dft;
   std::vector<double> pa(length, 0.0), pb(length, 0.0);
   std::copy(a.begin(), a.end(), pa.begin());
@@ -72,15 +58,23 @@ Alignment align_excitation(std::span<const double> recorded, std::span<const dou
   double best_value = 0.0;
   for (std::size_t i = 0; i < c.size(); ++i)
     if (admissible(i)) best_value = std::max(best_value, std::abs(c[i]));
-  // A periodic sequence matches equally well a whole number of periods apart when the recording
-  // holds fewer periods than the sequence; take the latest such shift, which reads the first
-  // recorded period as the sequence's first (skipped as transient: the safe reading).
   Alignment best;
-  for (std::size_t i = c.size(); i-- > 0;)
-    if (admissible(i) && std::abs(c[i]) >= (1.0 - 1e-3) * best_value) {
-      best.offset = static_cast<std::ptrdiff_t>(i) - (ne - 1);
-      break;
-    }
+  std::size_t best_index = 0;
+  for (std::size_t i = 0; i < c.size(); ++i)
+    if (admissible(i) && std::abs(c[i]) == best_value) best_index = i;
+  best.offset = static_cast<std::ptrdiff_t>(best_index) - (ne - 1);
+  // A periodic sequence matches equally well a whole number of periods apart when the recording
+  // holds only part of it; take the latest such shift, which reads the first recorded period as
+  // the sequence's first (skipped as transient: the safe reading). When the best shift holds the
+  // whole sequence there is no such tie (a shift by one period of P loses 1/P of the match, which
+  // the noise tolerance below could not tell from a tie once P reaches 1000).
+  const bool whole = best.offset >= 0 && best.offset + ne <= nr;
+  if (!whole)
+    for (std::size_t i = c.size(); i-- > 0;)
+      if (admissible(i) && std::abs(c[i]) >= (1.0 - 1e-3) * best_value) {
+        best.offset = static_cast<std::ptrdiff_t>(i) - (ne - 1);
+        break;
+      }
   // Gain and correlation coefficient over the overlap, summed directly (exact, and cheap).
   const std::ptrdiff_t first = std::max<std::ptrdiff_t>(0, best.offset);
   const std::ptrdiff_t last = std::min(nr, best.offset + ne);
@@ -106,7 +100,8 @@ Alignment align_excitation(std::span<const double> recorded, std::span<const dou
 PeriodDetection detect_period(std::span<const double> x, std::size_t min_period) {
   PeriodDetection result;
   const std::size_t n = x.size();
-  if (n < 2 * std::max<std::size_t>(min_period, 2)) return result;
+  min_period = std::max<std::size_t>(min_period, 2);
+  if (n < 2 * min_period + 2) return result;
   const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(n);
   std::vector<double> centred(n);
   std::transform(x.begin(), x.end(), centred.begin(), [mean](double v) { return v - mean; });
@@ -117,10 +112,12 @@ PeriodDetection detect_period(std::span<const double> x, std::size_t min_period)
   const std::size_t max_lag = n / 2;
   std::vector<double> rho(max_lag + 2, 0.0);
   double largest = -1.0;
-  for (std::size_t lag = min_period; lag <= max_lag + 1 && lag < n; ++lag) {
+  // From one below the shortest lag: a peak needs both neighbours (a slowly varying signal falls
+  // smoothly from lag 0 and must not read as a period at min_period).
+  for (std::size_t lag = min_period - 1; lag <= max_lag + 1 && lag < n; ++lag) {
     const double head = prefix[n - lag], tail = prefix[n] - prefix[lag];
     rho[lag] = head > 0.0 && tail > 0.0 ? c[lag + n - 1] / std::sqrt(head * tail) : 0.0;
-    if (lag <= max_lag) largest = std::max(largest, rho[lag]);
+    if (lag >= min_period && lag <= max_lag) largest = std::max(largest, rho[lag]);
   }
   if (largest < 0.8) return result;
   for (std::size_t lag = min_period; lag <= max_lag; ++lag) {

@@ -125,7 +125,9 @@ void read_periodic(const PreambleReader& r, frf::Excitation& e) {
     if (!e.lines.empty() && k <= e.lines.back()) throw r.error(lines, "lines", "lines must rise");
     e.lines.push_back(k);
   }
-  if (e.lines.empty()) throw r.error(lines, "lines", "no lines");
+  // A single chirp is read by H1 and needs no lines; a periodic sequence does.
+  if (e.lines.empty() && !(e.type == frf::ExcitationType::kChirp && e.periods == 1))
+    throw r.error(lines, "lines", "no lines");
 }
 
 void read_steps(const Preamble& p, const PreambleReader& r, frf::Excitation& e) {

@@ -160,6 +160,11 @@ TEST_F(FrfExcitation, BadInputIsRefusedAndNothingIsWritten) {
   EXPECT_EQ(r.status, 3);
   EXPECT_THAT(r.err, HasSubstr("rec.csv (speed): does not hold the excitation"));
   EXPECT_FALSE(std::filesystem::exists(path("f.csv")));
+  // The design decides the estimator: an option choosing another is a usage error.
+  EXPECT_EQ(run("frf estimate rec.csv --input iq --response speed --excitation ms.csv --method h1 -o f.csv").status, 2);
+  EXPECT_EQ(run("frf estimate rec.csv --input iq --response speed --excitation ms.csv --closed-loop --reference iq "
+                "-o f.csv").status,
+            2);
   // A damaged design.
   std::string text = slurp(path("ms.csv"));
   text.replace(text.find("# periods: 4"), 12, "# periods: 5");

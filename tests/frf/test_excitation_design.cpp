@@ -192,6 +192,22 @@ TEST(ExcitationDesign, RefusesWhatCannotBePlayedNamingTheField) {
   ExcitationRequest periods = design_request(ExcitationType::kMultisine, 1, 100, 1e-3, 10, 1);
   periods.periods = 1;
   EXPECT_EQ(field_of([&] { (void)design_excitation(periods); }), "periods");
+  periods.periods = 20;  // periods of 0.5 s: lines 2 Hz apart, coarser than the range's 1 Hz
+  EXPECT_EQ(field_of([&] { (void)design_excitation(periods); }), "periods");
+  // Sine steps that cannot all lie in the range: 50 steps in 10 … 20 Hz with 1 s windows, and a
+  // range narrower than one line of the window.
+  ExcitationRequest crowded = design_request(ExcitationType::kSineSteps, 10, 20, 1e-3, 67, 1);
+  crowded.steps = 50;
+  EXPECT_EQ(field_of([&] { (void)design_excitation(crowded); }), "steps");
+  EXPECT_EQ(field_of(make(ExcitationType::kSineSteps, 10.2, 10.6, 1e-3, 2.7, 1)), "duration_s");
+  // A chirp of too few cycles would be moved by the whole-cycle closing (1.2 … 1.8 Hz in 1 s).
+  EXPECT_EQ(field_of(make(ExcitationType::kChirp, 1.2, 1.8, 1e-3, 1, 1)), "duration_s");
+  // Period lengths have no prime factor above 5 (the swapping runs hundreds of FFTs of them):
+  // 0.3 Hz at 8 kHz needs 26 667 samples, the next such length is 27 000, so 17 periods fit in
+  // 60 s, and the longest such length within 60 s / 17 = 28 235 samples is 28 125 = 3² · 5⁵.
+  const Excitation odd = design_excitation(design_request(ExcitationType::kMultisine, 0.3, 100, 1.25e-4, 60, 1));
+  EXPECT_EQ(odd.periods, 17u);
+  EXPECT_EQ(odd.period_samples, 28125u);
 }
 
 }  // namespace

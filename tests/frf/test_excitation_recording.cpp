@@ -73,6 +73,17 @@ TEST(ExcitationAlignment, FindsAShiftedScaledInvertedOrLateRecording) {
   // The recording started 777 samples into the sequence.
   const std::vector<double> late(e.samples.begin() + 777, e.samples.end());
   EXPECT_EQ(align_excitation(late, e.samples).offset, -777);
+  // A sequence of 1200 periods recorded whole: a shift by one period loses only 1/1200 of the
+  // match and must not win the tie-break meant for partial recordings.
+  ExcitationRequest many;
+  many.f_begin_hz = 50.0;
+  many.f_end_hz = 450.0;
+  many.ts = kRecTs;
+  many.duration_s = 24.0;
+  many.amplitude = 1.0;
+  const Excitation m = design_excitation(many);
+  ASSERT_EQ(m.periods, 1200u);
+  EXPECT_EQ(align_excitation(recording_of(m, 37, 100, 1.0), m.samples).offset, 37);
   // Not the excitation at all.
   std::vector<double> other(x.size());
   for (double& v : other) v = noise(rng);
@@ -91,6 +102,17 @@ TEST(ExcitationAlignment, DetectsThePeriodOfARepeatedSequence) {
   std::vector<double> white(5000);
   for (double& v : white) v = noise(rng);
   EXPECT_EQ(detect_period(white).period_samples, 0u);
+  // A slow sequence (lines 1 … 20 Hz of an 8000-sample period at 8 kHz): its autocorrelation falls
+  // smoothly from lag 0, which is no period at the shortest lag.
+  ExcitationRequest slow;
+  slow.f_begin_hz = 1.0;
+  slow.f_end_hz = 20.0;
+  slow.ts = 1.0 / 8000.0;
+  slow.duration_s = 3.0;
+  slow.amplitude = 1.0;
+  const Excitation s = design_excitation(slow);
+  ASSERT_EQ(s.period_samples, 8000u);
+  EXPECT_EQ(detect_period(s.samples).period_samples, 8000u);
 }
 
 TEST(RecordedEstimate, PeriodicMultisineAndChirpAreLeakageFree) {
@@ -111,7 +133,7 @@ TEST(RecordedEstimate, PeriodicMultisineAndChirpAreLeakageFree) {
 }
 
 TEST(RecordedEstimate, SingleChirpThroughH1) {
-  const Excitation e = recording_design(ExcitationType::kChirp, 0, 8.0);
+  const Excitation e = recording_design(ExcitationType::kChirp, 0, 10.0);  // ten cycles of 1 Hz
   const std::vector<double> x = recording_of(e, 500, 1000, 1.0);
   const std::vector<double> y = recording_filter(x);
   const RecordedEstimate r = estimate_recorded(e, x, y);

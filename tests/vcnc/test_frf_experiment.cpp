@@ -212,6 +212,10 @@ TEST(FrfExperiment, InsideAVelocityLoopTheBlockRecoversThePlant) {
   const core::DiscreteStateSpace sampled = core::discretize_zoh(core::to_state_space(tf), plant.ts());
   std::size_t compared = 0;
   for (const auto& p : e.response.points) {
+    // The plant's SNR, not the closed loop's, decides validity.
+    if (p.valid) {
+      EXPECT_GE(p.snr, frf::RfidBlock::kMinimumSnr) << p.freq_hz << " Hz";
+    }
     const double w = kTwoPi * p.freq_hz;
     const std::complex<double> truth = core::frequency_response(sampled, w)(0, 0);
     const std::complex<double> c_y = core::frequency_response(controller, w)(0, 1);

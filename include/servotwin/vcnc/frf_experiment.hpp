@@ -112,7 +112,10 @@ FrfExperiment run_frf_experiment(machine::FlexiblePlant& plant, const frf::RfidP
 /// its THD and SNR are those of the measured T. No semi-closed loop: the loop holds the mean.
 /// core::InputError naming "controller" when it does not have two inputs and one output, its
 /// period differs from the plant's, the plant does not measure a velocity, or the discrete loop
-/// of the plant's linear part and the controller is unstable (the largest |z| named).
+/// of the plant's linear part, its input delay and the controller is unstable (the largest |z|
+/// named; loops of more than 200 states, i.e. long delays, are left to the run's range abort).
+/// The SNR of each plant point is the measured T's over |1 − P·C_y| (δP/P = (δT/T)(1 − P·C_y)),
+/// and a point whose plant SNR falls below RfidBlock::kMinimumSnr is marked invalid.
 FrfExperiment run_frf_experiment_closed_loop(machine::FlexiblePlant& plant, const frf::RfidParameters& parameters,
                                              double max_time_s, const core::DiscreteStateSpace& controller,
                                              bool keep_trace, const FrfProgress& progress = {});
