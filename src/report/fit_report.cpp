@@ -59,6 +59,18 @@ Section model_section(const fit::FitReport& report) {
   t.rows.push_back({"iterations", std::to_string(r.iterations), ""});
   t.rows.push_back({"rms |ln(P_model/P_meas)|", num(r.rms_log_error, 4), "(0.01 = 1 %)"});
   s.tables.push_back(std::move(t));
+  if (!r.uncertainty_note.empty()) s.text += " Uncertainty: " + r.uncertainty_note + ".";
+  if (!report.left_out.empty()) {
+    // Issue 25 §1: what the measurement marked invalid and the fit therefore did not use.
+    Table left;
+    left.title = "Points left out (marked invalid by the measurement)";
+    left.header = {"frequency", "why"};
+    for (const std::string& line : report.left_out) {
+      const std::size_t colon = line.find(": ");
+      left.rows.push_back({line.substr(0, colon), colon == std::string::npos ? "" : line.substr(colon + 2)});
+    }
+    s.tables.push_back(std::move(left));
+  }
   return s;
 }
 

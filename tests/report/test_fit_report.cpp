@@ -53,6 +53,17 @@ TEST(FitReport, CarriesTheFittedModesAndTheMeasuredPointsOnTheModelsPhaseBranch)
   for (double e : response.charts[2].series[0].y) EXPECT_LT(e, 1e-6);
 }
 
+TEST(FitReport, ListsThePointsLeftOutAndWhy) {
+  core::FrequencyResponse measured = e10_response();
+  measured.points[3].valid = false;
+  measured.points[3].note = "THD 0.39 above 0.07 at amplitude 2.4";
+  const fit::FitReport fitted = fit::fit_plant(measured, {fit::ModelRequest::Kind::kTwoMass, 1});
+  ASSERT_EQ(fitted.left_out.size(), 1u);
+  const std::string html = testing::render(fit_report(measured, fitted, "e10.csv"));
+  EXPECT_NE(html.find("Points left out (marked invalid by the measurement)"), std::string::npos);
+  EXPECT_NE(html.find("THD 0.39 above 0.07 at amplitude 2.4"), std::string::npos);
+}
+
 TEST(FitReport, AnEmptyResponseIsAnInputError) {
   EXPECT_THROW((void)fit_report({}, fit::FitReport{}, "x.csv"), core::InputError);
 }
