@@ -121,6 +121,9 @@ BENCHMARK(BM_LargestRobustOmegaStar)->Arg(30)->Arg(48)->Unit(benchmark::kMillise
 // a placement, a Routh test, two peaks and a bandwidth with the HF dynamics), the final analysis
 // (indices, margins, time responses). Arg 0: PI; 1: PI with an uncertainty weight (RP in the scan);
 // 2: PID; 3: PI + P position loop; 4: LQG (kbw and kff searches, C7.13); 5: LQG with W2;
+// 9: PI with notch:auto (issue 25 §5: the scan per candidate notch width, plus the design without;
+// compare with Arg 0, the same PI without filters); 10: PI with a given notch and low-pass at 8 kHz
+// (the placement on plant·F).
 // 6: H∞ with the automatic ω0S/ω0T search (C7.14; issue §9: <= 1 s), on the belt axis's full two-mode
 // model (C7.16 active, the default: a 12-state generalized plant); 7: the position LQG (lqg-pos,
 // kbw search with a prefilter bisection per candidate); 8: the position H∞ (hinf-pos: cubic
@@ -157,13 +160,29 @@ void BM_TuneAutomatic(benchmark::State& state) {
     case 8:
       o.structure = Structure::kHinfPos;
       break;
+    case 9:
+      o.ts = 1.0 / 8000.0;
+      o.auto_notch = true;
+      break;
+    case 10: {
+      o.ts = 1.0 / 8000.0;
+      DriveFilterSpec notch;
+      notch.frequency_hz = 40.0;
+      notch.width_hz = 12.0;
+      notch.depth_db = 20.0;
+      DriveFilterSpec low;
+      low.type = DriveFilterType::kLowpass;
+      low.frequency_hz = 600.0;
+      o.drive_filters = {notch, low};
+      break;
+    }
     default:
       break;
   }
   for (auto _ : state) benchmark::DoNotOptimize(tune(model, o));
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_TuneAutomatic)->DenseRange(0, 8)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TuneAutomatic)->DenseRange(0, 10)->Unit(benchmark::kMillisecond);
 
 /// The load-measuring designs of C7.17 on the belt axis's first mode alone (they need a two-mass
 /// load): Arg 0 hinf-load (the w0S scan over its whole range: feasibility is not monotone on load

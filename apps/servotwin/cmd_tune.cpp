@@ -36,6 +36,7 @@ struct TuneArgs {
   std::string modes = "active";
   std::optional<int> controller_order;
   std::optional<double> rolloff_hz;
+  std::vector<std::string> drive_filters;
   bool raw_motor_velocity = false;
   std::optional<double> measurement_noise;
   std::string target_r = "2";
@@ -59,7 +60,6 @@ tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
   o.xi_v = a.xi_v;
   o.hinf_modes = *tuning::parse_mode_handling(a.modes);
   o.controller_order = a.controller_order;
-  if (a.rolloff_hz) o.rolloff_rad_s = 2.0 * std::numbers::pi * *a.rolloff_hz;
   o.lqg.raw_motor_velocity = a.raw_motor_velocity;
   if (a.measurement_noise) {
     o.lqg.measurement_noise = *a.measurement_noise;  // the user's V is kept, not raised
@@ -71,6 +71,7 @@ tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
   o.allow_negative_kd = a.allow_negative_kd;
   o.setpoint_weight = a.setpoint_weight;
   apply_spec(a.spec, plant, o);
+  apply_drive_filters(a.drive_filters, a.rolloff_hz, o);
   return o;
 }
 
@@ -78,6 +79,35 @@ tuning::TuneOptions options_from(const TuneArgs& a, const TunePlant& plant) {
 std::string margin(double v, const char* unit) {
   if (std::isinf(v)) return "inf (no crossing)";
   return fmt::format("{:.3g} {}", v, unit);
+}
+
+/// Each drive filter as a drive's menu takes it, and its biquad coefficients.
+void print_drive_filters(const std::vector<tuning::DriveFilter>& filters) {
+  for (std::size_t i = 0; i < filters.size(); ++i) {
+    const tuning::DriveFilter& f = filters[i];
+    const tuning::DriveFilterSpec& s = f.spec;
+    std::string what;
+    switch (s.type) {
+      case tuning::DriveFilterType::kNotch:
+        what = fmt::format("notch at {:.4g} Hz, width {:.4g} Hz, depth {:.3g} dB", s.frequency_hz, s.width_hz, s.depth_db);
+        break;
+      case tuning::DriveFilterType::kLowpass:
+        what = s.damping ? fmt::format("second-order lowpass at {:.4g} Hz, damping {:.3g}", s.frequency_hz, *s.damping)
+                         : fmt::format("first-order lowpass at {:.4g} Hz", s.frequency_hz);
+        break;
+      case tuning::DriveFilterType::kBiquad:
+        what = fmt::format("biquad: numerator {:.4g} Hz / damping {:.3g}, denominator {:.4g} Hz / damping {:.3g}",
+                           s.frequency_hz, *s.damping, s.pole_frequency_hz, s.pole_damping);
+        break;
+    }
+    fmt::print("drive filter {}: {}{} (at the controller's output, designed with)\n", i + 1, what,
+               s.automatic ? " [notch:auto]" : "");
+    if (f.discrete)
+      fmt::print("  discrete at ts = {:.4g} s (Tustin, prewarped at {:.4g} Hz): b0 b1 b2 = {:.10g} {:.10g} {:.10g}, "
+                 "a1 a2 = {:.10g} {:.10g}\n",
+                 f.discrete->ts, f.discrete->prewarp_hz, f.discrete->b0, f.discrete->b1, f.discrete->b2, f.discrete->a1,
+                 f.discrete->a2);
+  }
 }
 
 /// The pole-placement part of the summary: advice, admissible range, ω* and the gains.
@@ -92,6 +122,7 @@ void print_cascade(const tuning::TuneResult& r, double hz) {
   fmt::print("gains (model units): Kp = {:.6g}, Ki = {:.6g}", g.kp, g.ki);
   if (g.kd != 0.0) fmt::print(", Kd = {:.6g}, tau = {:.4g} s", g.kd, g.tau);
   fmt::print(", setpoint weight wp = {}\n", g.wp);
+  print_drive_filters(c.drive_filters);
 }
 
 /// The P position loop of pi+p and lqg+p.
@@ -352,10 +383,15 @@ void register_tune(CLI::App& app, Action& selected) {
                   "check on the full model); LQG: first designs on mode 1, the others on the extended model")
       ->check(CLI::IsMember({"active", "passive", "first"}))
       ->capture_default_str();
+  cmd->add_option("--drive-filter", a->drive_filters,
+                  "A filter the drive runs at the controller's output (repeatable): notch:auto (on the mode the PI "
+                  "cannot damp, sized by the bandwidth search), notch:F_HZ:WIDTH_HZ:DEPTH_DB, lowpass:F_HZ[:ZETA] or "
+                  "biquad:FZ_HZ:ZETA_Z:FP_HZ:ZETA_P; designed with, written as continuous and discrete biquad "
+                  "coefficients at --ts (required). pi, pid, pi+p; H-infinity takes one first-order lowpass (its roll-off)");
   cmd->add_option("--rolloff-hz", a->rolloff_hz,
-                  "H-infinity: a first-order low-pass at the controller's output with this corner [Hz], designed with: "
-                  "a strictly proper controller that rolls off above it (C7.14's is biproper: its gain stays flat at "
-                  "high frequency, amplifying sensor noise)");
+                  "The lowpass case of --drive-filter: a first-order low-pass at the controller's output with this "
+                  "corner [Hz], designed with. H-infinity: a strictly proper controller that rolls off above it (C7.14's "
+                  "is biproper: its gain stays flat at high frequency, amplifying sensor noise)");
   cmd->add_option("--controller-order", a->controller_order,
                   "H-infinity: reduce the controller to this many states by balanced truncation of its stable part "
                   "(the integrator and unstable poles are kept; default: its minimal realization)");
@@ -379,7 +415,9 @@ void register_tune(CLI::App& app, Action& selected) {
                "  servotwin tune table-5.1 --structure lqg-pos --ts 0.000125 -o lqg-pos.json\n"
                "  servotwin tune table-5.1 --structure hinf-load -o hinf-load.json\n"
                "  servotwin tune table-5.1 --structure lqg-load --ts 0.000125 -o lqg-load.json\n"
-               "  servotwin tune plant_model.json --delay 0.0005 --w2-num 2.6,0 --w2-den 1,15 --ms 1.6\n");
+               "  servotwin tune plant_model.json --delay 0.0005 --w2-num 2.6,0 --w2-den 1,15 --ms 1.6\n"
+               "  servotwin tune testbed-2 --ms 2.5 --mt 2.5 --drive-filter notch:auto -o pi_notch.json\n"
+               "  servotwin tune plant_model.json --ts 0.000125 --drive-filter notch:180:60:20 --drive-filter lowpass:800\n");
   add_tune_compare(*cmd, selected);
   cmd->callback([a, cmd, &selected] {
     if (cmd->got_subcommand("compare")) return;  // its own callback chose the action

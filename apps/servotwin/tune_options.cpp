@@ -4,6 +4,10 @@
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
+#include <numbers>
+#include <string>
+#include <vector>
+
 #include "command.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/frf_csv.hpp"
@@ -81,6 +85,95 @@ void apply_spec(const TuneSpecArgs& a, const TunePlant& plant, tuning::TuneOptio
   if (a.delay) o.hf.delay_s = *a.delay;
   o.ts = a.ts ? a.ts : plant.ts;
   if (o.ts) check_sample_period(*o.ts, "--ts");
+}
+
+namespace {
+
+constexpr const char* kDriveFilterForms =
+    "notch:auto, notch:F_HZ:WIDTH_HZ:DEPTH_DB, lowpass:F_HZ, lowpass:F_HZ:ZETA or biquad:FZ_HZ:ZETA_Z:FP_HZ:ZETA_P";
+
+/// The numbers after the filter's name.
+std::vector<double> filter_numbers(const std::string& text, const std::vector<std::string>& fields) {
+  std::vector<double> out;
+  for (std::size_t i = 1; i < fields.size(); ++i) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(fields[i], &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != fields[i].size())
+      throw core::InputError(core::at_field("--drive-filter"),
+                             fmt::format("\"{}\": field {} (\"{}\") is not a number; expected {}", text, i + 1,
+                                         fields[i], kDriveFilterForms));
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<std::string> split_colons(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  for (std::size_t pos; (pos = text.find(':', start)) != std::string::npos; start = pos + 1)
+    out.push_back(text.substr(start, pos - start));
+  out.push_back(text.substr(start));
+  return out;
+}
+
+}  // namespace
+
+void apply_drive_filters(const std::vector<std::string>& texts, std::optional<double> rolloff_hz,
+                         tuning::TuneOptions& o) {
+  using tuning::DriveFilterSpec;
+  using tuning::DriveFilterType;
+  for (const std::string& text : texts) {
+    const std::vector<std::string> f = split_colons(text);
+    const auto fail = [&](const std::string& why) {
+      throw core::InputError(core::at_field("--drive-filter"),
+                             fmt::format("\"{}\": {}; expected {}", text, why, kDriveFilterForms));
+    };
+    if (f[0] == "notch" && f.size() == 2 && f[1] == "auto") {
+      if (o.auto_notch) fail("notch:auto given twice");
+      o.auto_notch = true;
+      continue;
+    }
+    DriveFilterSpec s;
+    const std::vector<double> v = (f[0] == "notch" || f[0] == "lowpass" || f[0] == "biquad")
+                                      ? filter_numbers(text, f)
+                                      : (fail("unknown filter \"" + f[0] + "\""), std::vector<double>{});
+    if (f[0] == "notch") {
+      if (v.size() != 3) fail("a notch takes its centre, width and depth");
+      s.type = DriveFilterType::kNotch;
+      s.frequency_hz = v[0];
+      s.width_hz = v[1];
+      s.depth_db = v[2];
+    } else if (f[0] == "lowpass") {
+      if (v.empty() || v.size() > 2) fail("a lowpass takes its corner and, for second order, its damping");
+      s.type = DriveFilterType::kLowpass;
+      s.frequency_hz = v[0];
+      if (v.size() == 2) s.damping = v[1];
+    } else {
+      if (v.size() != 4) fail("a biquad takes the numerator's frequency and damping, then the denominator's");
+      s.type = DriveFilterType::kBiquad;
+      s.frequency_hz = v[0];
+      s.damping = v[1];
+      s.pole_frequency_hz = v[2];
+      s.pole_damping = v[3];
+    }
+    o.drive_filters.push_back(s);
+  }
+  if (rolloff_hz) {
+    // The lowpass case: H-infinity designs with it as its roll-off; a PI/PID carries it as a filter.
+    if (tuning::is_hinf(o.structure)) {
+      o.rolloff_rad_s = 2.0 * std::numbers::pi * *rolloff_hz;
+    } else {
+      DriveFilterSpec s;
+      s.type = DriveFilterType::kLowpass;
+      s.frequency_hz = *rolloff_hz;
+      o.drive_filters.push_back(s);
+    }
+  }
 }
 
 }  // namespace servotwin::cli

@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "servotwin/tuning/tune.hpp"
 #include "tune_input.hpp"
@@ -29,5 +30,12 @@ void add_spec_options(CLI::App& cmd, TuneSpecArgs& args);
 /// on a measured response, printed), the plant's HF dynamics overridden by the options, and the
 /// sample period (the option's, else the plant description's). core::InputError names the option.
 void apply_spec(const TuneSpecArgs& args, const TunePlant& plant, tuning::TuneOptions& options);
+
+/// `--drive-filter` (repeatable): notch:auto, notch:F_HZ:WIDTH_HZ:DEPTH_DB, lowpass:F_HZ[:ZETA] or
+/// biquad:FZ_HZ:ZETA_Z:FP_HZ:ZETA_P, into options.drive_filters / options.auto_notch; and
+/// `--rolloff-hz F` (the lowpass case: H-infinity's roll-off, else lowpass:F). core::InputError
+/// naming the option and the text at fault.
+void apply_drive_filters(const std::vector<std::string>& texts, std::optional<double> rolloff_hz,
+                         tuning::TuneOptions& options);
 
 }  // namespace servotwin::cli

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "drive_filter_json.hpp"
 #include "json_reader.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/machine_json.hpp"
@@ -857,6 +858,8 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
     throw std::invalid_argument("controller_to_json: the compensator section belongs to exactly the full-order controllers");
   if (tuning::is_hinf(c.structure) != (c.full_order && c.full_order->hinf.has_value()))
     throw std::invalid_argument("controller_to_json: the H-infinity summary belongs to exactly the hinf and hinf-pos controllers");
+  if (!c.drive_filters.empty() && full_order)
+    throw std::invalid_argument("controller_to_json: drive filters belong to the pi, pid and pi+p controllers");
   if ((c.structure == Structure::kLqgPos) != (c.full_order && c.full_order->position_weights.has_value()))
     throw std::invalid_argument("controller_to_json: the position-LQG weights belong to exactly the lqg-pos controllers");
   const double wz = finite(c.plant.omega_z, "plant.omega_z");
@@ -889,6 +892,7 @@ json controller_to_json(const tuning::Controller& c, std::string_view plant_sour
             {"a", finite(p.a, "plant.a")}}},
           {"gains", full_order ? json(nullptr) : gains_json(c.physical, c.kpp_physical, "gains")},
           {"normalized", full_order ? json(nullptr) : gains_json(c.normalized, c.kpp_normalized, "normalized")},
+          {"drive_filters", detail::drive_filters_json(c.drive_filters)},
           {"state_space", state_space_json(ss, "state_space", c.structure)},
           {"discrete", discrete},
           {"design",
@@ -912,8 +916,8 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
   const json document = detail::parse_json_text(text, source_name);
   check_format(document, kControllerFormat, source_name);
   const Section root(document, "", source_name);
-  root.object.allow_only({"format", "structure", "loop", "feedback", "plant", "gains", "normalized", "state_space",
-                          "discrete", "design", "predicted", "robustness", "position", "lqg", "hinf", "notes"});
+  root.object.allow_only({"format", "structure", "loop", "feedback", "plant", "gains", "normalized", "drive_filters",
+                          "state_space", "discrete", "design", "predicted", "robustness", "position", "lqg", "hinf", "notes"});
   LoadedController out;
   tuning::Controller& c = out.controller;
 
@@ -950,6 +954,9 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
     c.kpp_physical = physical.kpp;
     c.kpp_normalized = normalized.kpp;
   }
+  c.drive_filters = detail::read_drive_filters(document, root.object, "drive_filters");
+  if (!c.drive_filters.empty() && tuning::is_full_order(c.structure))
+    root.fail("drive_filters", "expected none for an \"" + structure + "\" controller (its compensator holds its filters)");
   read_state_space(root, tuning::controller_state_space(c), continuous_check_frequencies(c.plant.omega_z, c.physical),
                    c.structure);
   c.discrete = read_discrete(root, c, c.prewarp_rad_s);

@@ -258,6 +258,32 @@ Table design_table(const Context& c) {
   return t;
 }
 
+/// A drive filter as one row: what it is, and its discrete biquad (b0 b1 b2 / a1 a2) when known.
+std::vector<std::string> drive_filter_row(const tuning::DriveFilter& f) {
+  const tuning::DriveFilterSpec& s = f.spec;
+  std::string what;
+  switch (s.type) {
+    case tuning::DriveFilterType::kNotch:
+      what = fmt::format("notch {} Hz, width {} Hz, depth {} dB", num(s.frequency_hz, 5), num(s.width_hz, 4),
+                         num(s.depth_db, 3));
+      break;
+    case tuning::DriveFilterType::kLowpass:
+      what = s.damping ? fmt::format("lowpass {} Hz, damping {}", num(s.frequency_hz, 5), num(*s.damping, 3))
+                       : fmt::format("lowpass {} Hz (first order)", num(s.frequency_hz, 5));
+      break;
+    case tuning::DriveFilterType::kBiquad:
+      what = fmt::format("biquad {} Hz/{} over {} Hz/{}", num(s.frequency_hz, 5), num(*s.damping, 3),
+                         num(s.pole_frequency_hz, 5), num(s.pole_damping, 3));
+      break;
+  }
+  if (s.automatic) what += " (notch:auto" + (f.reason.empty() ? std::string() : ": " + f.reason) + ")";
+  const std::string biquad =
+      f.discrete ? fmt::format("b = {} {} {}; a1 a2 = {} {}", num(f.discrete->b0, 10), num(f.discrete->b1, 10),
+                               num(f.discrete->b2, 10), num(f.discrete->a1, 10), num(f.discrete->a2, 10))
+                 : std::string();
+  return {"drive filter", what, biquad, ""};
+}
+
 Table gains_table(const Context& c) {
   const tuning::PidGains& n = c.controller.normalized;
   const tuning::PidGains& p = c.controller.physical;
@@ -277,6 +303,7 @@ Table gains_table(const Context& c) {
         {"position gain Kpp", num(*c.controller.kpp_normalized, 7), num(*c.controller.kpp_physical, 7), "1/s"});
   if (c.controller.discrete)
     t.rows.push_back({"discretized (Tustin) at ts", "", num(c.controller.discrete->ts * 1e3, 5), "ms"});
+  for (const tuning::DriveFilter& f : c.controller.drive_filters) t.rows.push_back(drive_filter_row(f));
   return t;
 }
 

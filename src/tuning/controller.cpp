@@ -6,6 +6,7 @@
 #include <string>
 
 #include "servotwin/core/error.hpp"
+#include "servotwin/tuning/uncertainty.hpp"
 
 namespace servotwin::tuning {
 
@@ -108,14 +109,33 @@ core::StateSpace to_physical(const core::StateSpace& n, const PlantScales& plant
   return {wz * n.A, wz * input * n.B, torque * n.C, torque * input * n.D};
 }
 
+namespace {
+
+/// The drive filters' chain on the normalized time axis (s_physical = ωz s).
+core::TransferFunction normalized_filters(const Controller& c) {
+  return to_normalized_time(filter_chain(c.drive_filters), c.plant.omega_z);
+}
+
+}  // namespace
+
+ControllerTf with_output_filter(const ControllerTf& k, const core::TransferFunction& f) {
+  return {core::series(k.feedback, f), core::series(k.reference, f)};
+}
+
 core::StateSpace controller_state_space(const Controller& c) {
-  if (!is_full_order(c.structure)) return controller_state_space(c.physical);
+  if (!is_full_order(c.structure)) {
+    if (c.drive_filters.empty()) return controller_state_space(c.physical);
+    return core::series(controller_state_space(c.physical), core::to_state_space(filter_chain(c.drive_filters)));
+  }
   if (!c.full_order) throw std::invalid_argument("controller_state_space: a full-order controller without its compensator");
   return to_physical(c.full_order->compensator, c.plant, is_position_controller(c.structure));
 }
 
 ControllerTf normalized_controller(const Controller& c) {
-  if (!is_full_order(c.structure)) return pid_controller(c.normalized);
+  if (!is_full_order(c.structure)) {
+    if (c.drive_filters.empty()) return pid_controller(c.normalized);
+    return with_output_filter(pid_controller(c.normalized), normalized_filters(c));
+  }
   if (!c.full_order) throw std::invalid_argument("normalized_controller: a full-order controller without its compensator");
   return compensator_form(c.structure, c.full_order->compensator);
 }
@@ -137,7 +157,7 @@ VelocityLoop compensator_loop(const NormalizedPlant& plant, Structure structure,
 }
 
 VelocityLoop controller_loop(const NormalizedPlant& plant, const Controller& c, bool with_hf, bool with_higher_modes) {
-  if (!is_full_order(c.structure)) return VelocityLoop(plant, pid_controller(c.normalized), with_hf, with_higher_modes);
+  if (!is_full_order(c.structure)) return VelocityLoop(plant, normalized_controller(c), with_hf, with_higher_modes);
   if (!c.full_order) throw std::invalid_argument("controller_loop: a full-order controller without its compensator");
   return compensator_loop(plant, c.structure, c.full_order->compensator, with_hf, with_higher_modes);
 }
@@ -167,7 +187,15 @@ core::DiscreteStateSpace discretize_controller(const PidGains& physical, double 
 core::DiscreteStateSpace discretize_controller(const Controller& controller, double ts,
                                                std::optional<double> prewarp_rad_s) {
   check_period(ts, prewarp_rad_s);
-  return core::discretize_tustin(controller_state_space(controller), ts, prewarp_rad_s);
+  if (controller.drive_filters.empty() || is_full_order(controller.structure))
+    return core::discretize_tustin(controller_state_space(controller), ts, prewarp_rad_s);
+  // The gains' part prewarped at the loop's frequency, each filter at its own (as a drive runs them).
+  const core::DiscreteStateSpace k = core::discretize_tustin(controller_state_space(controller.physical), ts, prewarp_rad_s);
+  std::vector<DriveFilter> filters;
+  for (const DriveFilter& f : controller.drive_filters) filters.push_back(make_drive_filter(f.spec, ts, "ts"));
+  const core::DiscreteStateSpace chain = discrete_chain(filters, ts);
+  const core::StateSpace s = core::series({k.A, k.B, k.C, k.D}, {chain.A, chain.B, chain.C, chain.D});
+  return {s.A, s.B, s.C, s.D, ts};
 }
 
 }  // namespace servotwin::tuning

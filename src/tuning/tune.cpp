@@ -15,6 +15,7 @@
 #include "servotwin/core/norms.hpp"
 #include "servotwin/tuning/position_loop.hpp"
 #include "servotwin/tuning/uncertainty.hpp"
+#include "auto_notch.hpp"
 
 namespace servotwin::tuning {
 
@@ -32,6 +33,24 @@ constexpr double kTargetRFractionOfR = 0.9;    // the largest automatic r̄ (r̄
 
 void require(bool ok, const char* flag, const std::string& message) {
   if (!ok) throw InputError(at_field(flag), message);
+}
+
+/// A filter request: the period it is designed for, a structure that takes it, each spec.
+void validate_drive_filters(const TuneOptions& o) {
+  require(o.ts.has_value() || is_hinf(o.structure), "--ts",
+          "a drive filter runs at the drive's sample period and is written as discrete biquads: give --ts");
+  require(!is_lqg(o.structure), "--drive-filter",
+          "the LQG structures take no drive filter (their Kalman filter shapes the controller's dynamics); use pi, pid, "
+          "pi+p or an H-infinity structure");
+  if (is_hinf(o.structure)) {
+    const bool one_rolloff = !o.auto_notch && o.drive_filters.size() == 1 &&
+                             o.drive_filters.front().type == DriveFilterType::kLowpass && !o.drive_filters.front().damping;
+    require(one_rolloff, "--drive-filter",
+            "an H-infinity controller takes one first-order lowpass (its roll-off, designed with); it places its own "
+            "notches on higher modes with --hinf-modes passive (catalog C7.16)");
+    require(!o.rolloff_rad_s, "--drive-filter", "give the roll-off once: --drive-filter lowpass:F_HZ or --rolloff-hz");
+  }
+  for (const DriveFilterSpec& f : o.drive_filters) validate(f, o.ts, "--drive-filter");
 }
 
 void validate(const TuneOptions& o) {
@@ -69,8 +88,10 @@ void validate(const TuneOptions& o) {
   if (o.rolloff_rad_s) {
     require(std::isfinite(*o.rolloff_rad_s) && *o.rolloff_rad_s > 0.0, "--rolloff-hz",
             fmt::format("expected a corner frequency > 0, got {} rad/s", *o.rolloff_rad_s));
-    require(is_hinf(o.structure), "--rolloff-hz", "a controller roll-off is offered for hinf and hinf-pos");
+    require(is_hinf(o.structure), "--rolloff-hz",
+            "rolloff_rad_s is the H-infinity roll-off; a PI/PID takes it as a drive filter (--drive-filter lowpass:F_HZ)");
   }
+  if (!o.drive_filters.empty() || o.auto_notch) validate_drive_filters(o);
   if (o.controller_order)
     require(*o.controller_order >= 1, "--controller-order",
             fmt::format("expected a number of controller states >= 1, got {}", *o.controller_order));
@@ -119,6 +140,9 @@ std::vector<double> scan_grid(const NormalizedPlant& plant) {
 struct GainDesigner {
   const NormalizedPlant& plant;
   const TuneOptions& options;
+  /// The drive filters at the controller's output, normalized time (nullptr: none): the PI's
+  /// pair is placed on the plant followed by them.
+  const core::TransferFunction* filter = nullptr;
 
   [[nodiscard]] double tau_normalized(double omega_star) const {
     return options.tau ? *options.tau * plant.omega_z : default_derivative_time_constant(plant.r, omega_star);
@@ -132,7 +156,8 @@ struct GainDesigner {
       g = d.gains;
       if (warnings) warnings->insert(warnings->end(), d.warnings.begin(), d.warnings.end());
     } else {
-      const PiGains pi = pi_pole_placement(plant.motor(false), omega_star, options.zeta_star).gains;
+      const core::TransferFunction p = filter ? core::series(plant.motor(false), *filter) : plant.motor(false);
+      const PiGains pi = pi_pole_placement(p, omega_star, options.zeta_star).gains;
       g.kp = pi.kp;
       g.ki = pi.ki;
     }
@@ -978,7 +1003,18 @@ void tune_pid_automatic_ratio(TuneResult& result, const TuneOptions& options, co
 /// The cascade path of tune() (pi, pid, pi+p): ω*, the gains, their analysis and robustness.
 void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
   const NormalizedPlant& plant = result.plant;
-  const GainDesigner design{plant, options};
+  Controller& c = result.controller;
+  c.drive_filters.clear();
+  for (const DriveFilterSpec& spec : options.drive_filters)
+    c.drive_filters.push_back(make_drive_filter(spec, options.ts, "--drive-filter"));
+  const std::optional<core::TransferFunction> filter =
+      c.drive_filters.empty() ? std::nullopt
+                              : std::optional(to_normalized_time(filter_chain(c.drive_filters), plant.omega_z));
+  const GainDesigner design{plant, options, filter ? &*filter : nullptr};
+  const auto evaluate = [&](double w) {
+    const ControllerTf k = pid_controller(design(w));
+    return check(w, VelocityLoop(plant, filter ? with_output_filter(k, *filter) : k));
+  };
   const double kd =
       options.structure == Structure::kPid ? virtual_inertia_kd(plant.r, options.target_r.value_or(kDefaultTargetR)) : 0.0;
   result.range = admissible_range(plant, options.zeta_star, kd);
@@ -988,7 +1024,6 @@ void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecChec
                                  "slower than the assigned one everywhere); lower --zeta-star",
                                  options.zeta_star, plant.r));
   }
-  Controller& c = result.controller;
   c.design.zeta_star = options.zeta_star;
   if (options.structure == Structure::kPid) c.design.r_target = options.target_r.value_or(kDefaultTargetR);
 
@@ -1003,8 +1038,9 @@ void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecChec
     c.design.omega_star = w;
     c.design.omega_star_source = "given";
   } else {
-    for (double w : candidates(result.range, options.scan_points)) result.scan.push_back(check(w, design(w)));
-    const TuneResult::Candidate chosen = choose(result.scan, [&](double w) { return check(w, design(w)); });
+    result.scan.clear();
+    for (double w : candidates(result.range, options.scan_points)) result.scan.push_back(evaluate(w));
+    const TuneResult::Candidate chosen = choose(result.scan, evaluate);
     if (!chosen.feasible) no_feasible_omega(result.scan, options);
     c.design.omega_star = chosen.omega_star;
     c.design.omega_star_source =
@@ -1013,8 +1049,8 @@ void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecChec
   }
   c.normalized = design(c.design.omega_star, &c.notes);
   c.physical = to_physical(c.normalized, plant);
-  const VelocityLoop loop(plant, c.normalized);
-  c.predicted = analyse(plant, c.normalized);
+  const VelocityLoop loop = controller_loop(plant, c);
+  c.predicted = analyse(plant, loop, {});
   if (!c.predicted.closed_loop_stable) {
     c.notes.push_back("the loop with the known HF dynamics is UNSTABLE at this omega*: choose a smaller one");
   }
@@ -1023,10 +1059,95 @@ void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecChec
   if (!result.advice.verdict.empty()) c.notes.push_back(result.advice.verdict);
 }
 
+/// pi, pid (automatic r̄ or not), pi+p.
+void tune_cascade_structure(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
+  if (options.structure == Structure::kPid && !options.target_r) {
+    tune_pid_automatic_ratio(result, options, check);
+  } else {
+    tune_cascade(result, options, check);
+  }
+}
+
+std::string hz(const NormalizedPlant& plant, double omega) {
+  return fmt::format("{:.4g} Hz", plant.physical_frequency(omega) / (2.0 * std::numbers::pi));
+}
+
+/// notch:auto (auto_notch.hpp): the cascade tuned with each candidate notch on the target mode,
+/// the largest bandwidth kept; without a target, or when no candidate meets the spec, a note says
+/// why and the design goes on without the notch. The design without it is tuned too, to report
+/// what the notch gained.
+void tune_cascade_with_auto_notch(TuneResult& result, const TuneOptions& options, const SpecCheck& check) {
+  const NormalizedPlant& plant = result.plant;
+  const std::optional<detail::NotchTarget> target = detail::notch_target(plant);
+  const std::vector<DriveFilterSpec> notches =
+      target ? detail::notch_candidates(*target, plant.omega_z, *options.ts) : std::vector<DriveFilterSpec>{};
+  std::optional<TuneResult> without;
+  try {
+    without = result;
+    tune_cascade_structure(*without, options, check);
+  } catch (const InputError&) {
+    without.reset();
+  }
+  std::optional<TuneResult> best;
+  for (const DriveFilterSpec& notch : notches) {
+    TuneOptions o = options;
+    o.drive_filters.push_back(notch);
+    TuneResult trial = result;
+    try {
+      tune_cascade_structure(trial, o, check);
+    } catch (const InputError&) {
+      continue;
+    }
+    if (!best || compared_bandwidth(trial.controller.predicted) > compared_bandwidth(best->controller.predicted))
+      best = std::move(trial);
+  }
+  const auto bandwidth = [&](const TuneResult& r) { return hz(plant, compared_bandwidth(r.controller.predicted)); };
+  if (!best) {
+    if (!without) tune_cascade_structure(result, options, check);  // throws the spec's error
+    result = std::move(*without);
+    result.controller.notes.push_back(
+        !target ? "notch:auto: no notch placed: the PI damps the first mode itself (r within sqrt(3)..sqrt(5), "
+                  "catalog C7.4) and there is no higher mode"
+        : notches.empty()
+            ? fmt::format("notch:auto: no notch placed: the target, {} at {}, lies at or above the Nyquist frequency "
+                          "of --ts",
+                          target->reason, hz(plant, target->omega))
+            : fmt::format("notch:auto: no notch placed: no candidate on {} at {} meets the spec", target->reason,
+                          hz(plant, target->omega)));
+    return;
+  }
+  if (without && compared_bandwidth(without->controller.predicted) >= compared_bandwidth(best->controller.predicted)) {
+    // A notch that gains nothing only costs phase and robustness to the mode's shift: none placed.
+    const std::string gained = bandwidth(*best);
+    result = std::move(*without);
+    result.controller.notes.push_back(fmt::format(
+        "notch:auto: no notch placed: on {} at {} the best of {} widths reaches {} bandwidth {}, not more than the {} "
+        "without (the PI is not limited by this mode)",
+        target->reason, hz(plant, target->omega), notches.size(), plant.load_estimate() ? "load" : "motor", gained,
+        bandwidth(result)));
+    return;
+  }
+  result = std::move(*best);
+  DriveFilter& notch = result.controller.drive_filters.back();
+  notch.reason = target->reason;
+  result.controller.notes.push_back(fmt::format(
+      "notch:auto: a notch at {:.4g} Hz, width {:.3g} Hz, depth {:.3g} dB on {} (best of {} widths); {} bandwidth "
+      "{} with it, {} without",
+      notch.spec.frequency_hz, notch.spec.width_hz, notch.spec.depth_db, target->reason, notches.size(),
+      plant.load_estimate() ? "load" : "motor", bandwidth(result),
+      without ? bandwidth(*without) : std::string("no omega* meeting the spec")));
+}
+
 }  // namespace
 
-TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
-  validate(options);
+TuneResult tune(const fit::PlantModel& model, const TuneOptions& given) {
+  validate(given);
+  TuneOptions options = given;
+  if (is_hinf(options.structure) && !options.drive_filters.empty()) {
+    // The H-infinity roll-off is its one drive filter (validate_drive_filters), designed with.
+    options.rolloff_rad_s = 2.0 * std::numbers::pi * options.drive_filters.front().frequency_hz;
+    options.drive_filters.clear();
+  }
   TuneResult result;
   result.plant = normalize(model, options.hf);
   result.plant.chain_load = options.chain_load;
@@ -1057,10 +1178,10 @@ TuneResult tune(const fit::PlantModel& model, const TuneOptions& options) {
     tune_lqg_position(result, options, check);
   } else if (is_full_order(options.structure)) {
     tune_lqg(result, options, check);
-  } else if (options.structure == Structure::kPid && !options.target_r) {
-    tune_pid_automatic_ratio(result, options, check);
+  } else if (options.auto_notch) {
+    tune_cascade_with_auto_notch(result, options, check);
   } else {
-    tune_cascade(result, options, check);
+    tune_cascade_structure(result, options, check);
   }
   if (!plant.higher_modes.empty()) c.notes.push_back(higher_modes_note(options, plant.higher_modes));
   // The note matters where a load side is used: the loop's load numbers, the LQG's design model or

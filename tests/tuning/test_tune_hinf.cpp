@@ -293,7 +293,7 @@ TEST(TuneHinf, RollOffMakesTheControllerStrictlyProperAndQuietAtHighFrequency) {
   EXPECT_GT(c.predicted.bandwidth_load, 0.8 * plain.controller.predicted.bandwidth_load);
   // Offered for the H-infinity structures only, and the corner must be a frequency.
   o.structure = Structure::kPi;
-  test::expect_input_error([&] { (void)tune(m, o); }, "--rolloff-hz", "hinf and hinf-pos");
+  test::expect_input_error([&] { (void)tune(m, o); }, "--rolloff-hz", "--drive-filter lowpass:F_HZ");
   o = hinf_options();
   o.rolloff_rad_s = -1.0;
   test::expect_input_error([&] { (void)tune(m, o); }, "--rolloff-hz", "> 0");

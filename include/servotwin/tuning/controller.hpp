@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "servotwin/core/state_space.hpp"
+#include "servotwin/tuning/drive_filter.hpp"
 #include "servotwin/tuning/loop_analysis.hpp"
 #include "servotwin/tuning/hinf.hpp"
 #include "servotwin/tuning/lqg.hpp"
@@ -156,6 +157,10 @@ struct Controller {
   LoopIndices predicted;                ///< velocity-loop indices, normalized units
   RobustnessSummary robustness;
   std::optional<PositionSummary> position;           ///< pi+p, lqg+p, lqg-pos, hinf-pos only
+  /// pi, pid, pi+p: the drive's filters at the controller's output (drive_filter.hpp), physical.
+  /// They are part of the controller: normalized_controller(), controller_state_space(),
+  /// controller_loop() and discretize_controller() include them.
+  std::vector<DriveFilter> drive_filters;
   std::optional<core::DiscreteStateSpace> discrete;  ///< the velocity controller at the drive's period
   std::optional<double> prewarp_rad_s;               ///< Tustin prewarp frequency (physical)
   std::vector<std::string> notes;       ///< warnings and facts a user must see
@@ -172,12 +177,16 @@ struct Controller {
 [[nodiscard]] core::StateSpace to_physical(const core::StateSpace& normalized, const PlantScales& plant,
                                           bool position_inputs = false);
 
-/// The controller in the model's units: the PID's realization, or the full-order compensator
-/// de-normalized. Throws std::invalid_argument for a full-order structure without its compensator.
+/// The controller in the model's units: the PID's realization followed by its drive filters, or
+/// the full-order compensator de-normalized. Throws std::invalid_argument for a full-order structure without its compensator.
 [[nodiscard]] core::StateSpace controller_state_space(const Controller& controller);
 
+/// `controller` followed by the filter `f` at its output: both transfer functions times f (their
+/// common denominator stays common).
+[[nodiscard]] ControllerTf with_output_filter(const ControllerTf& controller, const core::TransferFunction& f);
+
 /// The normalized velocity controller as the 2-DoF transfer functions a VelocityLoop takes: the
-/// PID's, or the full-order compensator's two_dof_form() (a position controller's in its
+/// PID's (with its drive filters, on the normalized time axis), or the full-order compensator's two_dof_form() (a position controller's in its
 /// velocity_form(): the loop's S, T and margins are then the position loop's).
 [[nodiscard]] ControllerTf normalized_controller(const Controller& controller);
 
@@ -203,7 +212,8 @@ struct Controller {
 /// (field "ts") when ts is not finite and > 0 or the prewarp frequency lies at or above Nyquist.
 [[nodiscard]] core::DiscreteStateSpace discretize_controller(const PidGains& physical, double ts,
                                                              std::optional<double> prewarp_rad_s = std::nullopt);
-/// The same for any controller (controller_state_space(controller)).
+/// The same for any controller (controller_state_space(controller)); drive filters are discretized
+/// each at its own prewarp frequency (make_drive_filter at ts), as a drive runs them.
 [[nodiscard]] core::DiscreteStateSpace discretize_controller(const Controller& controller, double ts,
                                                              std::optional<double> prewarp_rad_s = std::nullopt);
 

@@ -104,6 +104,16 @@ struct TuneOptions {
   /// (VelocityHinfWeights::rolloff: designed with, the controller strictly proper); std::nullopt:
   /// C7.14's biproper controller.
   std::optional<double> rolloff_rad_s;
+  /// pi, pid, pi+p: the drive's filters at the controller's output (drive_filter.hpp), part of the
+  /// controller: the PI's pair is placed on the plant followed by them (pi_pole_placement of
+  /// plant·F, exact), the PID's gains are chosen by the search evaluating every candidate with
+  /// them, and the analysis includes them. hinf, hinf-pos, hinf-load take one first-order
+  /// low-pass, their roll-off (rolloff_rad_s, designed with); the LQG structures none. Requires ts.
+  std::vector<DriveFilterSpec> drive_filters;
+  /// pi, pid, pi+p: `notch:auto`: a notch on the mode the PI cannot damp (auto_notch: a higher
+  /// mode, else the first when r lies outside √3..√5), its width chosen by the bandwidth search
+  /// among a ladder of candidates (the zeros cancel the mode's poles). Requires ts.
+  bool auto_notch = false;
   /// hinf: the compensator's states after balanced truncation (the search designs every candidate
   /// at this order); std::nullopt: the minimal realization (VelocityHinfWeights::controller_order).
   std::optional<int> controller_order;
