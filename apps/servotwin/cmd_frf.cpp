@@ -110,8 +110,8 @@ Estimated estimate(const EstimateArgs& a, const io::SignalTable& table, const Gl
       o.detrend = detrend_of(a.detrend, frf::Detrend::kMean);
       o.min_freq_hz = a.fmin;
       o.max_freq_hz = a.fmax;
-      const frf::WelchSpectra s = frf::welch_spectra(r ? *r : x, y, table.ts, o);
-      out.response = r ? frf::estimate_closed_loop_h1(*r, x, y, table.ts, o) : frf::h1_from_spectra(s, table.ts, x.size(), o);
+      out.response = r ? frf::estimate_closed_loop_h1(*r, x, y, table.ts, o) : frf::estimate_h1(x, y, table.ts, o);
+      const frf::WelchLayout s = frf::welch_layout(x.size(), table.ts, o);
       out.comments.push_back(fmt::format("method: {} (Welch), segment {} samples, {} window, overlap {}, {} segments "
                                          "({:.1f} effective averages), df {} Hz",
                                          r ? "closed loop, indirect S_ry/S_ru" : "h1", s.segment_length, a.window, a.overlap, s.segments, s.effective_averages,

@@ -56,37 +56,70 @@ double effective_averages(const std::vector<double>& w, std::size_t step, std::s
   return k / sum;
 }
 
-void validate(std::span<const double> x, std::span<const double> y, double ts, const WelchOptions& o) {
-  detail::check_signals(x, y, ts);
+/// The options against a record of `samples` samples (the signals themselves checked by the caller).
+void validate_options(std::size_t samples, const WelchOptions& o) {
   if (!(o.overlap >= 0.0 && o.overlap < 1.0))
     throw core::InputError(core::at_field("overlap"), "overlap must be a fraction in [0, 1), got " + std::to_string(o.overlap));
-  if (o.segment_length != 0 && (o.segment_length < 16 || o.segment_length > x.size()))
+  if (o.segment_length != 0 && (o.segment_length < 16 || o.segment_length > samples))
     throw core::InputError(core::at_field("segment"),
                            "segment length must be between 16 samples and the record length (" +
-                               std::to_string(x.size()) + "), got " + std::to_string(o.segment_length));
+                               std::to_string(samples) + "), got " + std::to_string(o.segment_length));
   if (!(o.min_freq_hz >= 0.0) || !(o.max_freq_hz > o.min_freq_hz))
     throw core::InputError(core::at_field("fmin/fmax"), "expected 0 <= fmin < fmax");
 }
 
+void validate(std::span<const double> x, std::span<const double> y, double ts, const WelchOptions& o) {
+  detail::check_signals(x, y, ts);
+  validate_options(x.size(), o);
+}
+
 }  // namespace
+
+namespace {
+
+/// The layout of a validated record, with the window it uses.
+WelchLayout layout_of(std::size_t samples, double ts, const WelchOptions& options, const std::vector<double>& window) {
+  WelchLayout l;
+  l.segment_length = window.size();
+  const std::size_t step = step_of(l.segment_length, options.overlap);
+  l.segments = segment_count(samples, l.segment_length, step);
+  l.df_hz = 1.0 / (static_cast<double>(l.segment_length) * ts);
+  l.effective_averages = effective_averages(window, step, l.segments);
+  return l;
+}
+
+std::size_t segment_length_of(std::size_t samples, const WelchOptions& options) {
+  return options.segment_length != 0 ? options.segment_length : default_segment_length(samples, options.overlap);
+}
+
+}  // namespace
+
+WelchLayout welch_layout(std::size_t samples, double ts, const WelchOptions& options) {
+  if (!(std::isfinite(ts) && ts > 0.0)) throw core::InputError(core::at_field("ts"), "sample period must be > 0");
+  if (samples < 16)
+    throw core::InputError(core::at_field("input"),
+                           "at least 16 samples are needed for a frequency response, got " + std::to_string(samples));
+  validate_options(samples, options);
+  return layout_of(samples, ts, options, make_window(options.window, segment_length_of(samples, options)));
+}
 
 WelchSpectra welch_spectra(std::span<const double> x, std::span<const double> y, double ts, const WelchOptions& options) {
   validate(x, y, ts, options);
-  const std::size_t length = options.segment_length != 0 ? options.segment_length
-                                                          : default_segment_length(x.size(), options.overlap);
+  const std::size_t length = segment_length_of(x.size(), options);
   const std::size_t step = step_of(length, options.overlap);
-  const std::size_t segments = segment_count(x.size(), length, step);
   const std::vector<double> window = make_window(options.window, length);
+  const WelchLayout layout = layout_of(x.size(), ts, options, window);
+  const std::size_t segments = layout.segments;
 
   WelchSpectra s;
   s.segment_length = length;
   s.segments = segments;
-  s.df_hz = 1.0 / (static_cast<double>(length) * ts);
+  s.df_hz = layout.df_hz;
   for (double v : window) {
     s.window_sum += v;
     s.window_square_sum += v * v;
   }
-  s.effective_averages = effective_averages(window, step, segments);
+  s.effective_averages = layout.effective_averages;
   const std::size_t lines = length / 2 + 1;
   s.sxx.assign(lines, 0.0);
   s.syy.assign(lines, 0.0);

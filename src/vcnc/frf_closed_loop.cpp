@@ -111,22 +111,10 @@ FrfExperiment run_frf_experiment_closed_loop(machine::FlexiblePlant& plant, cons
   FrfExperiment out;
   out.parameters = parameters;
   frf::RfidBlock block(parameters);
-  plant.reset();
   ControllerStepper loop(controller);
-  const double ts = plant.ts();
-  const auto max_samples = static_cast<long>(std::ceil(max_time_s / ts));
-  const long report_every = std::max(1L, std::lround(1.0 / ts));
-  if (keep_trace) out.trace.reserve(static_cast<std::size_t>(std::min(max_samples, 20'000'000L)));
-  double y = plant.measure().y;
-  long k = 0;
-  for (; k < max_samples; ++k) {
-    const frf::RfidOutput o = block.step(true, y, 0.0);
-    if (keep_trace) out.trace.push_back({static_cast<double>(k) * ts, o.mv, y, o.omega / kTwoPi, o.amplitude, o.thd, o.state});
-    if (o.state == frf::RfidState::kDone || o.state == frf::RfidState::kAborted) break;
-    y = plant.step(loop.step(o.mv, y)).y;
-    if (progress && k % report_every == 0) progress(static_cast<double>(k) * ts, block.points().size(), o.omega / kTwoPi);
-  }
-  detail::collect_results(block, k >= max_samples, out);
+  detail::run_block(
+      block, plant, max_time_s, keep_trace, progress, out, [](const frf::RfidOutput&) { return 0.0; },
+      [&loop](const frf::RfidOutput& o, double y) { return loop.step(o.mv, y); });
   // T -> P with the controller's own responses (the block measured y over its reference).
   for (core::FrequencyPoint& p : out.response.points) {
     const Eigen::MatrixXcd c = core::frequency_response(controller, kTwoPi * p.freq_hz);

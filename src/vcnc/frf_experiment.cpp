@@ -152,25 +152,10 @@ FrfExperiment run_frf_experiment(machine::FlexiblePlant& plant, const frf::RfidP
   out.parameters = parameters;
   out.dc_gain = dc_gain;
   frf::RfidBlock block(parameters);
-  plant.reset();
-  const double ts = plant.ts();
-  const auto max_samples = static_cast<long>(std::ceil(max_time_s / ts));
-  const long report_every = std::max(1L, std::lround(1.0 / ts));
-  if (keep_trace) out.trace.reserve(static_cast<std::size_t>(std::min(max_samples, 20'000'000L)));
-
-  double pv = plant.measure().y;
-  double cv = 0.0;
-  long k = 0;
-  for (; k < max_samples; ++k) {
-    const frf::RfidOutput o = block.step(true, pv, cv);
-    cv = -dc_gain * o.harmonics[0];
-    if (keep_trace)
-      out.trace.push_back({static_cast<double>(k) * ts, o.mv, pv, o.omega / kTwoPi, o.amplitude, o.thd, o.state});
-    if (o.state == frf::RfidState::kDone || o.state == frf::RfidState::kAborted) break;
-    pv = plant.step(o.mv).y;
-    if (progress && k % report_every == 0) progress(static_cast<double>(k) * ts, block.points().size(), o.omega / kTwoPi);
-  }
-  detail::collect_results(block, k >= max_samples, out);
+  detail::run_block(
+      block, plant, max_time_s, keep_trace, progress, out,
+      [dc_gain](const frf::RfidOutput& o) { return -dc_gain * o.harmonics[0]; },
+      [](const frf::RfidOutput& o, double) { return o.mv; });
   return out;
 }
 

@@ -140,6 +140,15 @@ TEST(H1, EffectiveAveragesFollowWelch) {
   const auto s = welch_spectra(x, y, 1.0, o);
   EXPECT_EQ(s.segments, 31u);
   EXPECT_NEAR(s.effective_averages, k / (1.0 + 2.0 * (1.0 - 1.0 / k) / 36.0), 1e-9);
+  // The layout alone (no spectra) is the one the spectra were averaged over; options out of
+  // range are refused alike.
+  const WelchLayout l = welch_layout(x.size(), 1.0, o);
+  EXPECT_EQ(l.segments, s.segments);
+  EXPECT_EQ(l.segment_length, s.segment_length);
+  EXPECT_EQ(l.df_hz, s.df_hz);
+  EXPECT_EQ(l.effective_averages, s.effective_averages);
+  o.segment_length = 8;
+  EXPECT_THROW((void)welch_layout(x.size(), 1.0, o), InputError);
 }
 
 TEST(H1, SineAmplitudeOnALineIsReported) {

@@ -72,6 +72,18 @@ struct WelchSpectra {
   double window_sum = 0.0, window_square_sum = 0.0;
 };
 
+/// How a record of `samples` samples is cut into Welch segments (what welch_spectra averages), without
+/// computing any spectrum: for messages and reports.
+struct WelchLayout {
+  double df_hz = 0.0;
+  std::size_t segment_length = 0;
+  std::size_t segments = 0;
+  double effective_averages = 0.0;
+};
+/// The layout welch_spectra() uses for a record of `samples` samples at period ts. core::InputError
+/// for options out of range (as welch_spectra).
+WelchLayout welch_layout(std::size_t samples, double ts, const WelchOptions& options = {});
+
 /// Welch-averaged auto and cross spectra of x and y (same length, at least 16 samples).
 WelchSpectra welch_spectra(std::span<const double> x, std::span<const double> y, double ts,
                            const WelchOptions& options = {});
