@@ -44,7 +44,7 @@ void print_summary(const std::string& source, const fit::FitReport& r) {
   const fit::PlantModel& m = f.model;
   fmt::print("{}: {} points, {} output ({})\n", source, f.points, fit::to_string(m.output), r.output.note);
   if (!r.left_out.empty()) {
-    fmt::print("left out {} point(s) the measurement marked invalid:\n", r.left_out.size());
+    fmt::print("left out {} point(s) (marked invalid by the measurement, or outliers of the first fit):\n", r.left_out.size());
     for (const std::string& why : r.left_out) fmt::print("  {}\n", why);
   }
   fmt::print("model: {} mode(s), rigid {}{}{}; {}\n", m.modes.size(), fit::to_string(m.rigid),

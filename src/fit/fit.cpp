@@ -46,6 +46,20 @@ bool has_invalid(const core::FrequencyResponse& response) {
   return std::any_of(response.points.begin(), response.points.end(), [](const auto& p) { return !p.valid; });
 }
 
+/// The standard deviation a point is weighted with: its measured one, inflated by its harmonic
+/// distortion on a swept-sine response (issue 25 §1): a point with THD q carries harmonics of q
+/// times the fundamental, the mark of a nonlinearity (friction, backlash) whose describing function
+/// departs from the linear plant by that order, so σ_eff² = σ² + (q|P|)²/2 (the distortion counted
+/// as one more circular error of relative size q/√2). Noise-free THD (q ≈ 0) leaves σ as measured.
+/// Only where every point has its std: swept-sine points carry SNR, not std, and weighting them by
+/// |P|/SNR was tried and moved the backlash and E14 estimates out of their tolerances (the block's
+/// SNR is the observer's, not the value's), so such a response keeps log-relative weights.
+double effective_std(const core::FrequencyPoint& p, core::QualityKind kind) {
+  if (kind != core::QualityKind::kThd || !(p.quality > 0.0)) return p.std_dev;
+  const double distortion = p.quality * std::abs(p.value);
+  return std::sqrt(p.std_dev * p.std_dev + 0.5 * distortion * distortion);
+}
+
 Data make_data(const core::FrequencyResponse& response) {
   Data d;
   d.known_std = std::all_of(response.points.begin(), response.points.end(), [](const auto& p) { return p.std_dev > 0.0; });
@@ -54,9 +68,50 @@ Data make_data(const core::FrequencyResponse& response) {
     d.log_meas.push_back(std::log(p.value));
     // std_dev is the circular complex standard deviation (E|δ|² = σ²), so each of Re and Im of
     // δ/P has standard deviation σ/(√2|P|).
-    d.weight.push_back(d.known_std ? std::sqrt(2.0) * std::abs(p.value) / p.std_dev : 1.0);
+    d.weight.push_back(d.known_std ? std::sqrt(2.0) * std::abs(p.value) / effective_std(p, response.quality_kind) : 1.0);
   }
   return d;
+}
+
+/// The outlier rule (issue 25 §1): with the fitted model, each point's weighted complex log
+/// residual e_i = w_i·(ln P_model − ln P_meas) (w from make_data). Under Gaussian errors |e| is
+/// Rayleigh distributed, whose median is σ·sqrt(2 ln 2); σ is estimated from the median so that
+/// the misfit itself does not hide outliers, and floored at the points' own std (1 in weighted
+/// units) or at 0.1 % relative error without std. A point with |e_i| > kOutlierSigmas·σ (Rayleigh tail
+/// exp(−c²/2) = 4e-5 per point at c = 4.5) is an outlier; at most a fifth of the points are
+/// rejected, the largest first, and never so many that the model would lack points.
+constexpr double kOutlierSigmas = 4.5;
+constexpr double kMaxOutlierFraction = 0.2;
+constexpr double kOutlierRelativeFloor = 1e-3;
+
+std::vector<std::size_t> outliers(const core::FrequencyResponse& response, const PlantModel& model,
+                                  std::size_t parameters, std::vector<double>& sigmas) {
+  const Data d = make_data(response);
+  std::vector<double> e(d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const Complex diff = std::log(model.response(d.omega[i])) - d.log_meas[i];
+    // Phases differ modulo 2π: the principal logs of two nearby values can sit on either side of ±π.
+    e[i] = d.weight[i] * std::abs(Complex(diff.real(), std::remainder(diff.imag(), 2.0 * std::numbers::pi)));
+  }
+  std::vector<double> sorted = e;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  // Floored: residuals within the points' own std (weighted data), or below 0.1 % relative error
+  // (unweighted), are the measurement, not outliers (a noise-free fit's rounding residuals are
+  // not Gaussian and their median says nothing).
+  const double floor = d.known_std ? 1.0 : kOutlierRelativeFloor;
+  const double sigma = std::max(floor, sorted[sorted.size() / 2] / std::sqrt(2.0 * std::log(2.0)));
+  std::vector<std::size_t> out;
+  if (!(sigma > 0.0)) return out;
+  for (std::size_t i = 0; i < e.size(); ++i)
+    if (e[i] > kOutlierSigmas * sigma) out.push_back(i);
+  std::sort(out.begin(), out.end(), [&](std::size_t a, std::size_t b) { return e[a] > e[b]; });
+  const auto by_fraction = static_cast<std::size_t>(kMaxOutlierFraction * static_cast<double>(d.size()));
+  // Each point gives two real residuals; keep more than the parameters.
+  const std::size_t by_count = d.size() > parameters / 2 + 1 ? d.size() - (parameters / 2 + 1) : 0;
+  out.resize(std::min({out.size(), by_fraction, by_count}));
+  sigmas.clear();
+  for (std::size_t i : out) sigmas.push_back(e[i] / sigma);
+  return out;
 }
 
 // ---- parameterization -------------------------------------------------------------------------
@@ -716,6 +771,23 @@ FitReport fit_plant(const core::FrequencyResponse& response, const ModelRequest&
   }
   report.selection.chosen = fits[*chosen].model.modes.size();
   report.result = std::move(fits[*chosen]);
+  if (options.reject_outliers) {
+    std::vector<double> sigmas;
+    const std::vector<std::size_t> bad = outliers(response, report.result.model, report.result.parameters, sigmas);
+    if (!bad.empty()) {
+      // Refit without them (once: the refit does not look again), the points listed in left_out.
+      core::FrequencyResponse cleaned = response;
+      for (std::size_t k = 0; k < bad.size(); ++k) {
+        core::FrequencyPoint& p = cleaned.points[bad[k]];
+        p.valid = false;
+        p.note = "outlier: residual " + num(sigmas[k], 3) + " robust sigma from the first fit (rule: > " +
+                 num(kOutlierSigmas, 2) + ")";
+      }
+      FitOptions once = options;
+      once.reject_outliers = false;
+      return fit_plant(cleaned, request, once);
+    }
+  }
   return report;
 }
 

@@ -63,7 +63,7 @@ Section model_section(const fit::FitReport& report) {
   if (!report.left_out.empty()) {
     // Issue 25 §1: what the measurement marked invalid and the fit therefore did not use.
     Table left;
-    left.title = "Points left out (marked invalid by the measurement)";
+    left.title = "Points left out (marked invalid by the measurement, or outliers of the first fit)";
     left.header = {"frequency", "why"};
     for (const std::string& line : report.left_out) {
       const std::size_t colon = line.find(": ");

@@ -51,6 +51,11 @@ struct FitOptions {
   bool delay = false;           ///< fit a pure delay e^{-sT}
   int max_iterations = 200;     ///< Levenberg–Marquardt iteration limit per start
   std::size_t max_modes = 4;    ///< largest n tried by automatic order selection
+  /// fit_plant: after the fit, points whose weighted residual exceeds 4.5 robust standard
+  /// deviations (σ from the median residual, Rayleigh; at least the points' own std, or 0.1 %
+  /// relative error without std) are outliers: left out (at most a fifth of
+  /// the points), listed in FitReport::left_out with their residual, and the model refitted once.
+  bool reject_outliers = true;
 };
 
 /// A value with its standard deviation (NaN when not identifiable from the data).
@@ -163,8 +168,9 @@ struct FitReport {
   Selection selection;
   OutputDetection output;
   ModelRequest request;
-  /// Points marked invalid by the measurement (FrequencyPoint::valid, issue 25 §1) and left out
-  /// of the fit: "1 Hz: THD 0.39 above 0.07 ...", in frequency order.
+  /// Points marked invalid by the measurement (FrequencyPoint::valid, issue 25 §1) or rejected by
+  /// the outlier rule (FitOptions::reject_outliers), left out of the fit: "1 Hz: THD 0.39 above
+  /// 0.07 ...", "3.2 Hz: outlier: residual 7.1 robust sigma ...", in frequency order.
   std::vector<std::string> left_out;
 };
 
