@@ -16,9 +16,12 @@ void AmplitudeAdapter::set_amplitude(double amplitude) noexcept {
   amplitude_ = std::clamp(amplitude, 0.0, law_.maximum);
 }
 
-double AmplitudeAdapter::update(double thd, double usage, double omega_ts) noexcept {
-  if (thd > law_.thd_threshold + law_.thd_hysteresis) relay_ = true;
-  else if (thd < law_.thd_threshold - law_.thd_hysteresis) relay_ = false;
+double AmplitudeAdapter::update(double thd, double usage, double omega_ts, double snr) noexcept {
+  const bool snr_rule = law_.snr_minimum > 0.0 && snr == snr;  // NaN: unknown
+  const bool snr_low = snr_rule && snr < law_.snr_minimum;
+  const bool snr_high = !snr_rule || snr > law_.snr_minimum * (1.0 + law_.snr_hysteresis);
+  if (thd > law_.thd_threshold + law_.thd_hysteresis || snr_low) relay_ = true;
+  else if (thd < law_.thd_threshold - law_.thd_hysteresis && snr_high) relay_ = false;
   // NaN THD (no first harmonic yet) leaves the relay as it was.
 
   const double periods = std::abs(omega_ts) / (2.0 * std::numbers::pi);  // fraction of a period per sample

@@ -109,6 +109,8 @@ AmplitudeLaw amplitude_law_of(const RfidParameters& p) {
   law.proportional = p.proportional_growth;
   law.thd_threshold = p.thd_threshold;
   law.thd_hysteresis = p.thd_hysteresis;
+  // With a known noise level the SNR drives the relay too (issue 25 §1).
+  law.snr_minimum = p.noise_level > 0.0 ? RfidBlock::kMinimumSnr : 0.0;
   law.reduce_ratio = p.range_margin;
   return law;
 }
@@ -369,7 +371,10 @@ RfidOutput RfidBlock::step(bool start, double pv, double cv) noexcept {
     case RfidState::kSweep:
     case RfidState::kSettle: {
       const bool trusted = state_ == RfidState::kSettle || detector_.holdoff == 0;
-      amplitude_ = adapter_.update(trusted ? thd : 0.0, limit_usage(pv, cv), omega_k * p_.ts);
+      // The SNR a point latched now would carry (latch()): the first harmonic over the noise level.
+      const double snr = trusted && p_.noise_level > 0.0 ? observer_.harmonic_amplitude(1) / p_.noise_level
+                                                         : std::numeric_limits<double>::infinity();
+      amplitude_ = adapter_.update(trusted ? thd : 0.0, limit_usage(pv, cv), omega_k * p_.ts, snr);
       if (state_ == RfidState::kSweep) advance_sweep(std::abs(running));
       else advance_settle(running, thd);
       break;

@@ -1,4 +1,5 @@
-// Amplitude adaptation law (dissertation C5.11): integrator + relay with hysteresis on THD, range
+// Amplitude adaptation law (dissertation C5.11): integrator + relay with hysteresis on THD (and on
+// the SNR, issue 25 §1), range
 // protection, arbitration decrease > hold > increase.
 #include "servotwin/frf/amplitude_adaptation.hpp"
 
@@ -61,6 +62,31 @@ TEST(AmplitudeAdapter, RelayHysteresis) {
   const double before = a.amplitude();
   a.update(0.09, 0.0, 0.01);
   EXPECT_EQ(a.amplitude(), before);
+}
+
+TEST(AmplitudeAdapter, LowSnrRaisesTheAmplitudeLikeHighThd) {
+  // Issue 25 §1: with SNR* = 3 and hysteresis 0.5, the relay switches on below SNR 3 even at a
+  // clean THD, stays on up to SNR 4.5 (3 x 1.5), and off above it with the THD below THD* - h.
+  AmplitudeLaw l = law();
+  l.snr_minimum = 3.0;
+  l.snr_hysteresis = 0.5;
+  AmplitudeAdapter a(l);
+  a.update(0.01, 0.0, 0.01, 10.0);
+  EXPECT_FALSE(a.relay());
+  const double before = a.amplitude();
+  a.update(0.01, 0.0, 0.01, 2.0);
+  EXPECT_TRUE(a.relay());
+  EXPECT_GT(a.amplitude(), before);
+  a.update(0.01, 0.0, 0.01, 4.0);
+  EXPECT_TRUE(a.relay());  // inside the band: holds
+  a.update(0.01, 0.0, 0.01, 5.0);
+  EXPECT_FALSE(a.relay());
+  // Unknown SNR (NaN, or the default) makes no demand; without SNR* the SNR is ignored.
+  a.update(0.01, 0.0, 0.01, std::nan(""));
+  EXPECT_FALSE(a.relay());
+  AmplitudeAdapter thd_only(law());
+  thd_only.update(0.01, 0.0, 0.01, 0.5);
+  EXPECT_FALSE(thd_only.relay());
 }
 
 TEST(AmplitudeAdapter, RangeProtectionArbitration) {

@@ -5,6 +5,8 @@
 /// response is distorted or noisy; range protection holds or lowers it when the measured output
 /// or the actuator command approaches its limit. Arbitration: decrease > hold > increase.
 
+#include <limits>
+
 namespace servotwin::frf {
 
 /// Settings of the amplitude law (validated by the owner, see RfidParameters).
@@ -15,6 +17,11 @@ struct AmplitudeLaw {
   double rate = 0.2;            ///< rc: relative change per excitation period, increment rc A(t0) per period
   double thd_threshold = 0.1;   ///< THD*
   double thd_hysteresis = 0.02; ///< h: relay on above THD* + h, off below THD* - h
+  /// SNR*: the relay also switches on while the point's SNR is below it (issue 25 §1: "the amplitude
+  /// rises until THD and SNR meet their limits") and off only above SNR*·(1 + snr_hysteresis) with
+  /// the THD below THD* - h. 0: the THD alone drives the relay (the document's law).
+  double snr_minimum = 0.0;
+  double snr_hysteresis = 0.5;
   double hold_ratio = 0.9;      ///< hold when the limit usage exceeds hold_ratio * reduce_ratio
   double reduce_ratio = 0.8;    ///< decrease when the limit usage exceeds this fraction
   double reduce_per_period = 0.5;  ///< amplitude factor per period while decreasing
@@ -36,14 +43,16 @@ class AmplitudeAdapter {
   void reset() noexcept;
   /// One sample. thd: current THD estimate; usage: how much of the allowed range is used
   /// (max over the output range and the actuator headroom, 1 = at the limit); omega_ts: excitation
-  /// phase advance per sample [rad]. Returns the new amplitude, always in [minimum, maximum].
-  double update(double thd, double usage, double omega_ts) noexcept;
+  /// phase advance per sample [rad]; snr: the response's current SNR (+inf or NaN: unknown, no
+  /// SNR demand). Returns the new amplitude, always in [minimum, maximum].
+  double update(double thd, double usage, double omega_ts,
+                double snr = std::numeric_limits<double>::infinity()) noexcept;
   /// Forces the amplitude (clamped to [0, maximum]), e.g. for the final ramp-out.
   void set_amplitude(double amplitude) noexcept;
 
   [[nodiscard]] double amplitude() const noexcept { return amplitude_; }
   [[nodiscard]] AmplitudeAction last_action() const noexcept { return action_; }
-  /// Relay output r: true while the THD asks for more amplitude.
+  /// Relay output r: true while the THD (or the SNR) asks for more amplitude.
   [[nodiscard]] bool relay() const noexcept { return relay_; }
   /// True when the THD wants more amplitude but the ceiling or the range protection blocks it.
   [[nodiscard]] bool blocked() const noexcept { return relay_ && action_ != AmplitudeAction::kIncrease; }
