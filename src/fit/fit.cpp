@@ -78,11 +78,13 @@ Data make_data(const core::FrequencyResponse& response) {
 /// Rayleigh distributed, whose median is σ·sqrt(2 ln 2); σ is estimated from the median so that
 /// the misfit itself does not hide outliers, and floored at the points' own std (1 in weighted
 /// units) or at 0.1 % relative error without std. A point with |e_i| > kOutlierSigmas·σ (Rayleigh tail
-/// exp(−c²/2) = 4e-5 per point at c = 4.5) is an outlier; at most a fifth of the points are
+/// exp(−c²/2) = 4e-5 per point at c = 4.5) is an outlier when it is isolated (neither frequency
+/// neighbour above 3 σ: a run of large residuals is model misfit, not a glitch); at most a fifth of the points are
 /// rejected, the largest first, and never so many that the model would lack points.
 constexpr double kOutlierSigmas = 4.5;
 constexpr double kMaxOutlierFraction = 0.2;
 constexpr double kOutlierRelativeFloor = 1e-3;
+constexpr double kNeighbourSigmas = 3.0;
 
 std::vector<std::size_t> outliers(const core::FrequencyResponse& response, const PlantModel& model,
                                   std::size_t parameters, std::vector<double>& sigmas) {
@@ -102,8 +104,11 @@ std::vector<std::size_t> outliers(const core::FrequencyResponse& response, const
   const double sigma = std::max(floor, sorted[sorted.size() / 2] / std::sqrt(2.0 * std::log(2.0)));
   std::vector<std::size_t> out;
   if (!(sigma > 0.0)) return out;
+  // A glitch is isolated; a run of large residuals is the model missing something (a mode it does
+  // not have, a load-side response without antiresonance), which rejecting would only hide.
+  const auto large = [&](std::size_t j) { return e[j] > kNeighbourSigmas * sigma; };
   for (std::size_t i = 0; i < e.size(); ++i)
-    if (e[i] > kOutlierSigmas * sigma) out.push_back(i);
+    if (e[i] > kOutlierSigmas * sigma && !(i > 0 && large(i - 1)) && !(i + 1 < e.size() && large(i + 1))) out.push_back(i);
   std::sort(out.begin(), out.end(), [&](std::size_t a, std::size_t b) { return e[a] > e[b]; });
   const auto by_fraction = static_cast<std::size_t>(kMaxOutlierFraction * static_cast<double>(d.size()));
   // Each point gives two real residuals; keep more than the parameters.

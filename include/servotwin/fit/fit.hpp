@@ -53,7 +53,8 @@ struct FitOptions {
   std::size_t max_modes = 4;    ///< largest n tried by automatic order selection
   /// fit_plant: after the fit, points whose weighted residual exceeds 4.5 robust standard
   /// deviations (σ from the median residual, Rayleigh; at least the points' own std, or 0.1 %
-  /// relative error without std) are outliers: left out (at most a fifth of
+  /// relative error without std) and isolated (neither neighbour above 3 σ: a run is model
+  /// misfit, not a glitch) are outliers: left out (at most a fifth of
   /// the points), listed in FitReport::left_out with their residual, and the model refitted once.
   bool reject_outliers = true;
 };
