@@ -95,7 +95,11 @@ std::vector<std::size_t> outliers(const core::FrequencyResponse& response, const
     // Phases differ modulo 2π: the principal logs of two nearby values can sit on either side of ±π.
     e[i] = d.weight[i] * std::abs(Complex(diff.real(), std::remainder(diff.imag(), 2.0 * std::numbers::pi)));
   }
-  std::vector<double> sorted = e;
+  // A non-finite residual (a model pole on the jω axis) is no ordering key for the median.
+  std::vector<double> sorted;
+  for (double v : e)
+    if (std::isfinite(v)) sorted.push_back(v);
+  if (sorted.empty()) return {};
   std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
   // Floored: residuals within the points' own std (weighted data), or below 0.1 % relative error
   // (unweighted), are the measurement, not outliers (a noise-free fit's rounding residuals are
@@ -671,6 +675,9 @@ FitReport fit_plant(const core::FrequencyResponse& response, const ModelRequest&
     FitReport report = fit_plant(response.valid_only(), request, options);
     for (const auto& p : response.points)
       if (!p.valid) report.left_out.push_back(num(p.freq_hz, 6) + " Hz: " + (p.note.empty() ? "marked invalid" : p.note));
+    // Invalid points and the refit's outliers in one frequency order.
+    std::stable_sort(report.left_out.begin(), report.left_out.end(),
+                     [](const std::string& a, const std::string& b) { return std::stod(a) < std::stod(b); });
     return report;
   }
   FitReport report;
@@ -790,7 +797,13 @@ FitReport fit_plant(const core::FrequencyResponse& response, const ModelRequest&
       }
       FitOptions once = options;
       once.reject_outliers = false;
-      return fit_plant(cleaned, request, once);
+      try {
+        return fit_plant(cleaned, request, once);
+      } catch (const core::InputError&) {
+        // The refit failed (too few points left, no order converged): keep the first fit.
+        report.result.message += "; the refit without " + std::to_string(bad.size()) +
+                                 " outlier(s) failed, so they were kept";
+      }
     }
   }
   return report;

@@ -8,7 +8,7 @@ namespace servotwin::frf {
 
 void AmplitudeAdapter::reset() noexcept {
   amplitude_ = std::clamp(law_.initial, 0.0, law_.maximum);
-  relay_ = false;
+  relay_ = thd_relay_ = snr_relay_ = false;
   action_ = AmplitudeAction::kHold;
 }
 
@@ -17,12 +17,16 @@ void AmplitudeAdapter::set_amplitude(double amplitude) noexcept {
 }
 
 double AmplitudeAdapter::update(double thd, double usage, double omega_ts, double snr) noexcept {
-  const bool snr_rule = law_.snr_minimum > 0.0 && snr == snr;  // NaN: unknown
-  const bool snr_low = snr_rule && snr < law_.snr_minimum;
-  const bool snr_high = !snr_rule || snr > law_.snr_minimum * (1.0 + law_.snr_hysteresis);
-  if (thd > law_.thd_threshold + law_.thd_hysteresis || snr_low) relay_ = true;
-  else if (thd < law_.thd_threshold - law_.thd_hysteresis && snr_high) relay_ = false;
+  if (thd > law_.thd_threshold + law_.thd_hysteresis) thd_relay_ = true;
+  else if (thd < law_.thd_threshold - law_.thd_hysteresis) thd_relay_ = false;
   // NaN THD (no first harmonic yet) leaves the relay as it was.
+  // The SNR's own relay with its own hysteresis: a THD inside its band must not keep an SNR demand
+  // on. Unknown SNR (NaN) leaves it as it was; without SNR* it never switches on.
+  if (law_.snr_minimum > 0.0 && snr == snr) {
+    if (snr < law_.snr_minimum) snr_relay_ = true;
+    else if (snr > law_.snr_minimum * (1.0 + law_.snr_hysteresis)) snr_relay_ = false;
+  }
+  relay_ = thd_relay_ || snr_relay_;
 
   const double periods = std::abs(omega_ts) / (2.0 * std::numbers::pi);  // fraction of a period per sample
   const bool usage_unknown = !(usage == usage);  // NaN: be conservative, never increase

@@ -372,8 +372,11 @@ RfidOutput RfidBlock::step(bool start, double pv, double cv) noexcept {
     case RfidState::kSettle: {
       const bool trusted = state_ == RfidState::kSettle || detector_.holdoff == 0;
       // The SNR a point latched now would carry (latch()): the first harmonic over the noise level.
-      const double snr = trusted && p_.noise_level > 0.0 ? observer_.harmonic_amplitude(1) / p_.noise_level
-                                                         : std::numeric_limits<double>::infinity();
+      // Not before the fade-in ends: the first harmonic of a fading-in excitation reads as no signal.
+      const bool faded_in = fade_done_ >= fade_length_;
+      const double snr = trusted && faded_in && p_.noise_level > 0.0
+                             ? observer_.harmonic_amplitude(1) / p_.noise_level
+                             : std::numeric_limits<double>::quiet_NaN();
       amplitude_ = adapter_.update(trusted ? thd : 0.0, limit_usage(pv, cv), omega_k * p_.ts, snr);
       if (state_ == RfidState::kSweep) advance_sweep(std::abs(running));
       else advance_settle(running, thd);

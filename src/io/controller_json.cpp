@@ -954,7 +954,11 @@ LoadedController parse_controller_json(std::string_view text, std::string_view s
     c.kpp_physical = physical.kpp;
     c.kpp_normalized = normalized.kpp;
   }
-  c.drive_filters = detail::read_drive_filters(document, root.object, "drive_filters");
+  std::optional<double> controller_ts;
+  if (const auto d = document.find("discrete"); d != document.end() && d->is_object() && d->contains("ts") &&
+                                                d->at("ts").is_number())
+    controller_ts = d->at("ts").get<double>();
+  c.drive_filters = detail::read_drive_filters(document, root.object, "drive_filters", controller_ts);
   if (!c.drive_filters.empty() && tuning::is_full_order(c.structure))
     root.fail("drive_filters", "expected none for an \"" + structure + "\" controller (its compensator holds its filters)");
   read_state_space(root, tuning::controller_state_space(c), continuous_check_frequencies(c.plant.omega_z, c.physical),

@@ -85,7 +85,8 @@ json drive_filters_json(const std::vector<tuning::DriveFilter>& filters) {
   return out;
 }
 
-std::vector<tuning::DriveFilter> read_drive_filters(const json& parent, const JsonObject& object, std::string_view key) {
+std::vector<tuning::DriveFilter> read_drive_filters(const json& parent, const JsonObject& object, std::string_view key,
+                                                    std::optional<double> controller_ts) {
   std::vector<tuning::DriveFilter> out;
   const auto it = parent.find(key);
   if (it == parent.end() || (it->is_array() && it->empty())) return out;
@@ -101,11 +102,19 @@ std::vector<tuning::DriveFilter> read_drive_filters(const json& parent, const Js
     std::optional<double> ts;
     const auto d = item.find("discrete");
     if (d != item.end() && !d->is_null()) ts = o.object("discrete").number("ts");
+    try {
+      tuning::validate(spec, std::nullopt, path);
+    } catch (const core::InputError& e) {
+      o.fail("type", "this " + tuning::to_string(spec.type) + ": " + e.reason());
+    }
+    if (ts && controller_ts && std::abs(*ts - *controller_ts) > 1e-12 * *controller_ts)
+      o.object("discrete").fail("ts", "is " + std::to_string(*ts) + " s but the controller is discretized at " +
+                                          std::to_string(*controller_ts) + " s");
     tuning::DriveFilter f;
     try {
       f = tuning::make_drive_filter(spec, ts, path);
     } catch (const core::InputError& e) {
-      o.fail("type", e.reason());
+      o.object("discrete").fail("ts", e.reason());
     }
     f.reason = o.string_or("reason", "");
     const JsonObject c = o.object("continuous");

@@ -124,8 +124,11 @@ ControllerTf with_output_filter(const ControllerTf& k, const core::TransferFunct
 
 core::StateSpace controller_state_space(const Controller& c) {
   if (!is_full_order(c.structure)) {
-    if (c.drive_filters.empty()) return controller_state_space(c.physical);
-    return core::series(controller_state_space(c.physical), core::to_state_space(filter_chain(c.drive_filters)));
+    // Each filter realized on its own: the product polynomial of several filters near a kHz has
+    // coefficients of ω⁶ ~ 1e22, a badly conditioned companion form.
+    core::StateSpace k = controller_state_space(c.physical);
+    for (const DriveFilter& f : c.drive_filters) k = core::series(k, core::to_state_space(f.continuous));
+    return k;
   }
   if (!c.full_order) throw std::invalid_argument("controller_state_space: a full-order controller without its compensator");
   return to_physical(c.full_order->compensator, c.plant, is_position_controller(c.structure));

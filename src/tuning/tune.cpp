@@ -37,11 +37,11 @@ void require(bool ok, const char* flag, const std::string& message) {
 
 /// A filter request: the period it is designed for, a structure that takes it, each spec.
 void validate_drive_filters(const TuneOptions& o) {
-  require(o.ts.has_value() || is_hinf(o.structure), "--ts",
-          "a drive filter runs at the drive's sample period and is written as discrete biquads: give --ts");
   require(!is_lqg(o.structure), "--drive-filter",
           "the LQG structures take no drive filter (their Kalman filter shapes the controller's dynamics); use pi, pid, "
           "pi+p or an H-infinity structure");
+  require(o.ts.has_value() || is_hinf(o.structure), "--ts",
+          "a drive filter runs at the drive's sample period and is written as discrete biquads: give --ts");
   if (is_hinf(o.structure)) {
     const bool one_rolloff = !o.auto_notch && o.drive_filters.size() == 1 &&
                              o.drive_filters.front().type == DriveFilterType::kLowpass && !o.drive_filters.front().damping;
@@ -1012,7 +1012,16 @@ void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecChec
                               : std::optional(to_normalized_time(filter_chain(c.drive_filters), plant.omega_z));
   const GainDesigner design{plant, options, filter ? &*filter : nullptr};
   const auto evaluate = [&](double w) {
-    const ControllerTf k = pid_controller(design(w));
+    PidGains g;
+    try {
+      g = design(w);
+    } catch (const InputError&) {
+      // The pair cannot be placed at this ω* (it sits on a zero of plant × filters): infeasible.
+      TuneResult::Candidate none;
+      none.omega_star = w;
+      return none;
+    }
+    const ControllerTf k = pid_controller(g);
     return check(w, VelocityLoop(plant, filter ? with_output_filter(k, *filter) : k));
   };
   const double kd =
@@ -1049,6 +1058,9 @@ void tune_cascade(TuneResult& result, const TuneOptions& options, const SpecChec
   }
   c.normalized = design(c.design.omega_star, &c.notes);
   c.physical = to_physical(c.normalized, plant);
+  if (filter)
+    c.notes.push_back("the admissible omega* range is the design plant's without the drive filters (C7.3); the "
+                      "search and the analysis include them");
   const VelocityLoop loop = controller_loop(plant, c);
   c.predicted = analyse(plant, loop, {});
   if (!c.predicted.closed_loop_stable) {
@@ -1103,7 +1115,10 @@ void tune_cascade_with_auto_notch(TuneResult& result, const TuneOptions& options
   }
   const auto bandwidth = [&](const TuneResult& r) { return hz(plant, compared_bandwidth(r.controller.predicted)); };
   if (!best) {
-    if (!without) tune_cascade_structure(result, options, check);  // throws the spec's error
+    if (!without) {
+      tune_cascade_structure(result, options, check);  // throws the spec's error
+      throw InputError(at_field("--drive-filter"), "notch:auto: no design meets the spec with or without a notch");
+    }
     result = std::move(*without);
     result.controller.notes.push_back(
         !target ? "notch:auto: no notch placed: the PI damps the first mode itself (r within sqrt(3)..sqrt(5), "

@@ -149,11 +149,16 @@ class SecondEncoder {
 /// integration.
 class LimitedController {
  public:
-  LimitedController(const core::DiscreteStateSpace& c, std::optional<double> limit)
-      : c_(c), limit_(limit), x_(Eigen::VectorXd::Zero(c.states())), next_(x_), both_(c.B.cols() == 3) {}
+  /// `running_states`: the trailing states that keep running while the limit is active (the drive
+  /// filters at the controller's output, which a drive runs whatever its command; the gains'
+  /// states before them stop: conditional integration).
+  LimitedController(const core::DiscreteStateSpace& c, std::optional<double> limit, Eigen::Index running_states = 0)
+      : c_(c), limit_(limit), x_(Eigen::VectorXd::Zero(c.states())), next_(x_), both_(c.B.cols() == 3),
+        frozen_(c.states() - std::clamp<Eigen::Index>(running_states, 0, c.states())) {}
 
-  /// The torque command for this sample; advances the states unless the limit is active. `load` is
-  /// read only by a controller with three inputs ([ω*, ωm, ωl]; `measured` is then ωm).
+  /// The torque command for this sample; advances the states, those of the gains only while the
+  /// limit is inactive. `load` is read only by a controller with three inputs ([ω*, ωm, ωl];
+  /// `measured` is then ωm).
   double update(double reference, double measured, double load = 0.0) noexcept {
     double raw = c_.C.row(0).dot(x_) + c_.D(0, 0) * reference + c_.D(0, 1) * measured;
     if (both_) raw += c_.D(0, 2) * load;
@@ -163,10 +168,11 @@ class LimitedController {
       u = std::copysign(*limit_, raw);
       limited_ = true;
     }
-    if (!limited_) {
+    if (!limited_ || frozen_ < c_.states()) {
       next_.noalias() = c_.A * x_;
       next_ += c_.B.col(0) * reference + c_.B.col(1) * measured;
       if (both_) next_ += c_.B.col(2) * load;
+      if (limited_) next_.head(frozen_) = x_.head(frozen_);
       x_.swap(next_);
     }
     return u;
@@ -178,6 +184,7 @@ class LimitedController {
   std::optional<double> limit_;
   Eigen::VectorXd x_, next_;
   bool both_;
+  Eigen::Index frozen_;
   bool limited_ = false;
 };
 
@@ -194,6 +201,7 @@ struct ControllerInputs {
   std::optional<double> kpp;
   bool position = false;
   bool both = false;
+  Eigen::Index filter_states = 0;  ///< the drive filters' states, last in the controller (LimitedController)
 };
 
 LoopRun run_loop(const machine::PlantConfig& config, const core::DiscreteStateSpace& controller,
@@ -207,7 +215,7 @@ LoopRun run_loop(const machine::PlantConfig& config, const core::DiscreteStateSp
   // difference or integral.
   const bool tf_plant = !std::holds_alternative<machine::MassChain>(config.model);
   FeedbackReader exact(config.settings.output, ts, m.y_exact);
-  LimitedController velocity_controller(controller, limit);
+  LimitedController velocity_controller(controller, limit, inputs.filter_states);
   const SecondEncoder second_encoder(config.settings);
   FeedbackReader second(second_encoder.output(), ts, second_encoder.read(m));
   const double reference = reference_of(test, amplitude);
@@ -430,7 +438,8 @@ DriveSimulation simulate_drive(const machine::PlantConfig& given_plant, const tu
 
   const ControllerInputs inputs{is_position_loop(controller) ? controller.kpp_physical : std::nullopt,
                                 tuning::is_position_controller(controller.structure),
-                                tuning::measures_both(controller.structure)};
+                                tuning::measures_both(controller.structure),
+                                tuning::filter_chain(controller.drive_filters).den().degree()};
   out.kpp = inputs.kpp;
   const Selector select = controlled_variable(out);
   const machine::PlantConfig linear_plant = linear_part(plant);

@@ -300,6 +300,21 @@ TEST_F(Cli, TuneWithDriveFiltersWritesTheBiquadsADriveTakes) {
   } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("drive_filters[1]"), std::string::npos) << e.what();
   }
+  // A filter discretized for another period than the controller's is refused too. The objects are
+  // written with sorted keys: the controller's "discrete" first, then the filters' own.
+  text = slurp(path("c.json"));
+  const std::string ts = "\"ts\": 0.0005";
+  const std::size_t first = text.find(ts);
+  const std::size_t second = text.find(ts, first + 1);
+  ASSERT_NE(second, std::string::npos);
+  text.replace(second, ts.size(), "\"ts\": 0.00025");
+  write("other_ts.json", text);
+  try {
+    (void)io::load_controller(path("other_ts.json").string());
+    ADD_FAILURE() << "a filter at another period was accepted";
+  } catch (const core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("discretized at"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(Cli, TuneRefusesFiltersNoDriveCanRun) {

@@ -65,8 +65,8 @@ TEST(AmplitudeAdapter, RelayHysteresis) {
 }
 
 TEST(AmplitudeAdapter, LowSnrRaisesTheAmplitudeLikeHighThd) {
-  // Issue 25 §1: with SNR* = 3 and hysteresis 0.5, the relay switches on below SNR 3 even at a
-  // clean THD, stays on up to SNR 4.5 (3 x 1.5), and off above it with the THD below THD* - h.
+  // Issue 25 §1: with SNR* = 3 and hysteresis 0.5, the SNR relay switches on below SNR 3 even at
+  // a clean THD, stays on up to SNR 4.5 (3 x 1.5), and off above it.
   AmplitudeLaw l = law();
   l.snr_minimum = 3.0;
   l.snr_hysteresis = 0.5;
@@ -80,6 +80,11 @@ TEST(AmplitudeAdapter, LowSnrRaisesTheAmplitudeLikeHighThd) {
   a.update(0.01, 0.0, 0.01, 4.0);
   EXPECT_TRUE(a.relay());  // inside the band: holds
   a.update(0.01, 0.0, 0.01, 5.0);
+  EXPECT_FALSE(a.relay());
+  // Each relay keeps its own band: a THD inside the THD band (0.09) does not hold an SNR demand on.
+  a.update(0.01, 0.0, 0.01, 2.0);
+  EXPECT_TRUE(a.relay());
+  a.update(0.09, 0.0, 0.01, 5.0);
   EXPECT_FALSE(a.relay());
   // Unknown SNR (NaN, or the default) makes no demand; without SNR* the SNR is ignored.
   a.update(0.01, 0.0, 0.01, std::nan(""));

@@ -17,9 +17,9 @@ struct AmplitudeLaw {
   double rate = 0.2;            ///< rc: relative change per excitation period, increment rc A(t0) per period
   double thd_threshold = 0.1;   ///< THD*
   double thd_hysteresis = 0.02; ///< h: relay on above THD* + h, off below THD* - h
-  /// SNR*: the relay also switches on while the point's SNR is below it (issue 25 §1: "the amplitude
-  /// rises until THD and SNR meet their limits") and off only above SNR*·(1 + snr_hysteresis) with
-  /// the THD below THD* - h. 0: the THD alone drives the relay (the document's law).
+  /// SNR*: a second relay, on while the point's SNR is below it (issue 25 §1: "the amplitude rises
+  /// until THD and SNR meet their limits"), off above SNR*·(1 + snr_hysteresis); the amplitude
+  /// rises while either relay is on. 0: the THD alone drives the amplitude (the document's law).
   double snr_minimum = 0.0;
   double snr_hysteresis = 0.5;
   double hold_ratio = 0.9;      ///< hold when the limit usage exceeds hold_ratio * reduce_ratio
@@ -61,7 +61,7 @@ class AmplitudeAdapter {
  private:
   AmplitudeLaw law_;
   double amplitude_;
-  bool relay_ = false;
+  bool relay_ = false, thd_relay_ = false, snr_relay_ = false;
   AmplitudeAction action_ = AmplitudeAction::kHold;
 };
 
