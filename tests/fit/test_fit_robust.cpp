@@ -31,7 +31,8 @@ std::size_t nearest(const core::FrequencyResponse& r, double omega) {
 
 /// Between the antiresonance and the resonance, where a wrong value moves both.
 std::size_t between_the_pair(const core::FrequencyResponse& r) {
-  const Mode& m = e37_plant(2).modes[0];
+  const PlantModel bed = e37_plant(2);  // named: a reference into a temporary would dangle
+  const Mode& m = bed.modes[0];
   return nearest(r, std::sqrt(m.antiresonance.omega_rad_s * m.resonance.omega_rad_s));
 }
 
