@@ -33,6 +33,20 @@ inline fit::PlantModel two_mass_model(double r, double zeta_z, double omega_z = 
   return m;
 }
 
+/// Catalog A6 configuration 2 (eq. 8.14, E37): (K/(s + τ1))(s² + 2ξz1 ωz1 s + ωz1²)/(s² + 2ξ1 ω1 s +
+/// ω1²)·1/(τ2 s + 1) with K = 454.5, τ1 = 0.15, τ2 = 0.0022 s (the lag's time constant, as the
+/// testbed-2 preset reads it), ξz1 = 0.24, ωz1 = 49.9, ξ1 = 0.02, ω1 = 254 rad/s (r = 5.09).
+inline fit::PlantModel test_bed_2() {
+  fit::PlantModel m;
+  m.rigid = fit::RigidKind::kRealPole;
+  m.rigid_pole_rad_s = 0.15;
+  const double lag = 1.0 / 0.0022;
+  m.lag_pole_rad_s = lag;
+  m.gain = 454.5 * lag;
+  m.modes = {{{49.9, 0.24}, {254.0, 0.02}}};
+  return m;
+}
+
 /// tests/data/tuning/tuning_reference.json (parsed once).
 inline const nlohmann::json& reference() {
   static const nlohmann::json j =

@@ -108,20 +108,6 @@ TEST(CompareStructures, WhatFailsEveryStructureIsTheCallersError) {
                            "structures", "velocity-loop");
 }
 
-/// Catalog A6 configuration 2 (eq. 8.14, E37): (K/(s + τ1))(s² + 2ξz1 ωz1 s + ωz1²)/(s² + 2ξ1 ω1 s +
-/// ω1²)·1/(τ2 s + 1) with K = 454.5, τ1 = 0.15, τ2 = 0.0022 s (the lag's time constant, as the
-/// testbed-2 preset reads it), ξz1 = 0.24, ωz1 = 49.9, ξ1 = 0.02, ω1 = 254 rad/s (r = 5.09).
-fit::PlantModel test_bed_2() {
-  fit::PlantModel m;
-  m.rigid = fit::RigidKind::kRealPole;
-  m.rigid_pole_rad_s = 0.15;
-  const double lag = 1.0 / 0.0022;
-  m.lag_pole_rad_s = lag;
-  m.gain = 454.5 * lag;
-  m.modes = {{{49.9, 0.24}, {254.0, 0.02}}};
-  return m;
-}
-
 TEST(CompareStructures, TestBedTwoHinfAgainstPiAsInTheDissertation) {
   // A6 configuration 2, both designs at ‖S‖∞, ‖Tl‖∞ <= 2.5 with motor feedback only (the printed
   // spec). The fit has no passive two-mass realization (ζz = 0.24 against ζp = 0.02), so the load
@@ -131,7 +117,7 @@ TEST(CompareStructures, TestBedTwoHinfAgainstPiAsInTheDissertation) {
   TuneOptions o;
   o.ms = o.mt = 2.5;
   o.hf.delay_s = 0.5 * 0.0005;  // the 2 kHz EtherCAT loop's zero-order hold, as the testbed-2 preset adds it
-  const std::vector<StructureComparison> c = compare_structures(test_bed_2(), o, {Structure::kPi, Structure::kHinf});
+  const std::vector<StructureComparison> c = compare_structures(test::test_bed_2(), o, {Structure::kPi, Structure::kHinf});
   const StructureComparison& pi = entry(c, Structure::kPi);
   const StructureComparison& hinf = entry(c, Structure::kHinf);
   ASSERT_TRUE(pi.result && hinf.result) << pi.failure << hinf.failure;
@@ -154,7 +140,7 @@ TEST(CompareStructures, TestBedTwoHinfAgainstPiAsInTheDissertation) {
 /// Catalog A6 configuration 1 (eq. 8.13, E37): K = 544.6, τ1 = 0.16, τ2 = 0.0038 s, modes
 /// (35.3, 0.19)/(70.8, 0.02) and (114.6, 0.11)/(260.1, 0.005) rad/s (r = 2.0).
 fit::PlantModel test_bed_1() {
-  fit::PlantModel m = test_bed_2();
+  fit::PlantModel m = test::test_bed_2();
   m.rigid_pole_rad_s = 0.16;
   const double lag = 1.0 / 0.0038;
   m.lag_pole_rad_s = lag;
@@ -221,11 +207,11 @@ TEST(CompareStructures, AnAutomaticTargetRatioRecoversThePidOnALaggedPlant) {
   o.ms = o.mt = 2.5;
   o.hf.delay_s = 0.5 * 0.0005;
   o.structure = Structure::kPid;
-  const double fixed = tune(test_bed_2(), o).controller.predicted.bandwidth_load;
+  const double fixed = tune(test::test_bed_2(), o).controller.predicted.bandwidth_load;
   o.target_r = std::nullopt;
-  const TuneResult automatic = tune(test_bed_2(), o);
+  const TuneResult automatic = tune(test::test_bed_2(), o);
   o.structure = Structure::kPi;
-  const double pi = tune(test_bed_2(), o).controller.predicted.bandwidth_load;
+  const double pi = tune(test::test_bed_2(), o).controller.predicted.bandwidth_load;
   EXPECT_LT(fixed, 0.1 * pi);
   EXPECT_GE(automatic.controller.predicted.bandwidth_load, 0.99 * pi);
   EXPECT_GT(*automatic.controller.design.r_target, 2.0);
@@ -246,7 +232,7 @@ TEST(CompareStructures, TheLqgDesignsOnANonPassiveRealization) {
   o.ms = o.mt = 2.5;
   o.hf.delay_s = 0.5 * 0.0005;
   o.structure = Structure::kLqg;
-  const TuneResult r = tune(test_bed_2(), o);
+  const TuneResult r = tune(test::test_bed_2(), o);
   EXPECT_TRUE(r.controller.predicted.closed_loop_stable);
   EXPECT_LE(r.controller.predicted.peak_s, 2.5 * (1.0 + 1e-3));
   EXPECT_LE(r.controller.predicted.peak_tl, 2.5 * (1.0 + 1e-3));

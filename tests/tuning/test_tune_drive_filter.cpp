@@ -26,18 +26,6 @@ DriveFilterSpec notch_spec(double f, double width, double depth) {
   return s;
 }
 
-/// Catalog A6 configuration 2 (eq. 8.14, E37), as in test_compare.cpp: r = 5.09, a lag, 2 kHz.
-fit::PlantModel bed_two_for_filters() {
-  fit::PlantModel m;
-  m.rigid = fit::RigidKind::kRealPole;
-  m.rigid_pole_rad_s = 0.15;
-  const double lag = 1.0 / 0.0022;
-  m.lag_pole_rad_s = lag;
-  m.gain = 454.5 * lag;
-  m.modes = {{{49.9, 0.24}, {254.0, 0.02}}};
-  return m;
-}
-
 bool notes_contain(const Controller& c, const std::string& text) {
   for (const std::string& n : c.notes)
     if (n.find(text) != std::string::npos) return true;
@@ -83,9 +71,9 @@ TEST(TuneDriveFilter, AutomaticNotchOnTestBedTwoTakesTheFirstResonance) {
   o.ms = o.mt = 2.5;
   o.ts = 0.0005;
   o.hf.delay_s = 0.5 * *o.ts;
-  const TuneResult without = tune(bed_two_for_filters(), o);
+  const TuneResult without = tune(test::test_bed_2(), o);
   o.auto_notch = true;
-  const TuneResult with = tune(bed_two_for_filters(), o);
+  const TuneResult with = tune(test::test_bed_2(), o);
   const Controller& c = with.controller;
   ASSERT_EQ(c.drive_filters.size(), 1u);
   EXPECT_NEAR(c.drive_filters.front().spec.frequency_hz, 254.0 / kTuneFilterTwoPi, 0.01);
