@@ -443,10 +443,13 @@ FitResult finish(const Run& run, const Layout& l, const Data& data) {
   }
   if (l.modes == 1) {
     const Eigen::Index b = l.mode_base(0);
-    const std::array<Eigen::Index, 4> idx{0, b, b + 1, b + 2};  // ln K, ln ωz, ln ζz, ln ωn
-    Eigen::Matrix4d sub;
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) sub(i, j) = c(idx[static_cast<std::size_t>(i)], idx[static_cast<std::size_t>(j)]);
+    // u = (ln K', ln ωz, ln ζz, ln ωn) with K' = K/τ2 when there is a lag (its DC gain 1/τ2
+    // belongs to the gain the motor inertia is read from): u = T θ, cov(u) = T C Tᵀ.
+    Eigen::MatrixXd to_u = Eigen::MatrixXd::Zero(4, c.cols());
+    to_u(0, 0) = 1.0;
+    if (l.lag) to_u(0, l.lag_index()) = -1.0;
+    for (Eigen::Index i = 0; i < 3; ++i) to_u(1 + i, b + i) = 1.0;
+    const Eigen::Matrix4d sub = to_u * c * to_u.transpose();
     f.physical = two_mass_parameters(f.model, sub);
   } else if (l.modes == 0) {
     f.physical.note = "not a two-mass system: the model has no flexible mode (rigid body only)";
@@ -550,7 +553,9 @@ PhysicalExtraction two_mass_parameters(const PlantModel& model, const Eigen::Mat
     out.note = "not a two-mass system: the model has " + std::to_string(model.modes.size()) + " flexible modes";
     return out;
   }
-  const double k1 = model.gain, wz = model.modes[0].antiresonance.omega_rad_s, zz = model.modes[0].antiresonance.zeta;
+  // With a lag 1/(s + τ2) the high-frequency asymptote of the mechanics is (K/τ2)/s.
+  const double k1 = model.lag_pole_rad_s ? model.gain / *model.lag_pole_rad_s : model.gain;
+  const double wz = model.modes[0].antiresonance.omega_rad_s, zz = model.modes[0].antiresonance.zeta;
   const double wn = model.modes[0].resonance.omega_rad_s, zn = model.modes[0].resonance.zeta;
   if (!(k1 > 0.0)) {
     out.note = "not a two-mass system: the gain is negative (sensor or actuator sign reversed?)";

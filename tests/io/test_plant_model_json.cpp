@@ -45,7 +45,11 @@ TEST(PlantModelJson, RoundTripKeepsThePlant) {
     EXPECT_EQ(j["modes"][0]["kind"], "antiresonance");
     EXPECT_GT(j["modes"][1]["freq_hz_std"].get<double>(), 0.0);
     ASSERT_FALSE(j["physical"].is_null());
-    EXPECT_NEAR(j["physical"]["motor_inertia"].get<double>(), 1.0 / report.result.model.gain, 1e-12);
+    // Im = 1/K' (C3.12), K' the mechanics' high-frequency gain: with a lag 1/(s + τ2) the model's
+    // gain also carries the lag's τ2, K' = K/τ2.
+    const fit::PlantModel& fitted = report.result.model;
+    EXPECT_NEAR(j["physical"]["motor_inertia"].get<double>(), fitted.lag_pole_rad_s.value_or(1.0) / fitted.gain,
+                1e-12 * fitted.lag_pole_rad_s.value_or(1.0) / fitted.gain);
     EXPECT_EQ(j["fit"]["points"], 40);
     EXPECT_EQ(j["selection"]["method"], "fixed");
     const LoadedPlantModel back = parse_plant_model_json(j.dump(), "model.json");

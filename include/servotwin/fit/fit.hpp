@@ -70,7 +70,7 @@ struct ModeUncertainty {
   Estimate antiresonance_omega, antiresonance_zeta, resonance_omega, resonance_zeta;
 };
 
-/// Two-mass physical parameters (C3.12) from K = 1/Im, ωz, ωn, ζz: Il = Im(r²−1), k = Il ωz²,
+/// Two-mass physical parameters (C3.12) from K = 1/Im (K/τ2 with a lag), ωz, ωn, ζz: Il = Im(r²−1), k = Il ωz²,
 /// b = 2 ζz ωz Il, r = ωn/ωz. Units follow the data: with torque input and rad/s output the
 /// inertias are in kg·m², k in N·m/rad and b in N·m·s/rad.
 struct TwoMassParameters {
@@ -86,8 +86,9 @@ struct PhysicalExtraction {
   std::string note;
 };
 
-/// Physical parameters of a one-mode model with the covariance of (ln K, ln ωz, ln ζz, ln ωn)
-/// (4×4; NaN entries give NaN standard deviations). Valid only for a one-mode model with K > 0 and
+/// Physical parameters of a one-mode model with the covariance of (ln K', ln ωz, ln ζz, ln ωn)
+/// (4×4; NaN entries give NaN standard deviations), K' = K, or K/τ2 when the model has a lag
+/// 1/(s + τ2) (the lag's DC gain belongs to 1/Im). Valid only for a one-mode model with K > 0 and
 /// r = ωn/ωz > 1 (antiresonance below resonance, collocated measurement).
 PhysicalExtraction two_mass_parameters(const PlantModel& model, const Eigen::Matrix4d& log_covariance);
 
