@@ -9,6 +9,7 @@
 #include "report_output.hpp"
 #include "servotwin/core/error.hpp"
 #include "servotwin/fit/fit.hpp"
+#include "servotwin/fit/friction_fit.hpp"
 #include "servotwin/fit/nonlinear.hpp"
 #include "servotwin/io/frf_csv.hpp"
 #include "servotwin/io/plant_model_json.hpp"
@@ -31,6 +32,7 @@ struct FitArgs {
   std::string out;
   std::string report;
   std::vector<std::string> amplitude_series;
+  bool friction = false;
 };
 
 /// "12.3 ± 0.4" (the ± part omitted when not identifiable).
@@ -96,6 +98,31 @@ void print_nonlinear(const fit::NonlinearMechanics& n) {
   fmt::print("    {}\n", n.backlash.note);
 }
 
+void print_friction(const fit::CoulombFit& c) {
+  if (!c.fitted) {
+    fmt::print("{}\n", c.note);
+    return;
+  }
+  const fit::Mode& m = c.model.modes.front();
+  fmt::print("with Coulomb friction ({}): rms log error {:.3g} (linear fit {:.3g}); {}\n", c.note, c.rms_log_error,
+             c.linear_rms_log_error, c.message);
+  fmt::print("  Coulomb friction motor Mm = {}, load Ml = {} (input units)\n", pm(c.motor_coulomb.value, c.motor_coulomb.std),
+             pm(c.load_coulomb.value, c.load_coulomb.std));
+  fmt::print("  linear part (written as the model):\n");
+  if (c.model.rigid == fit::RigidKind::kRealPole)
+    fmt::print("  rigid pole      = {} Hz (viscous damping {:.4g})\n",
+               pm(c.rigid_pole_rad_s.value / kTwoPi, c.rigid_pole_rad_s.std / kTwoPi), c.viscous_damping.value);
+  else
+    fmt::print("  rigid           = integrator (no viscous damping found)\n");
+  fmt::print("  mode 1: antiresonance {} Hz, zeta {}\n", pm(m.antiresonance.omega_rad_s / kTwoPi, c.mode.antiresonance_omega.std / kTwoPi),
+             pm(m.antiresonance.zeta, c.mode.antiresonance_zeta.std));
+  fmt::print("          resonance     {} Hz, zeta {}\n", pm(m.resonance.omega_rad_s / kTwoPi, c.mode.resonance_omega.std / kTwoPi),
+             pm(m.resonance.zeta, c.mode.resonance_zeta.std));
+  fmt::print("  motor inertia Im = {}\n  load inertia  Il = {}\n  stiffness     k  = {}\n  shaft damping b  = {}\n",
+             pm(c.motor_inertia.value, c.motor_inertia.std), pm(c.load_inertia.value, c.load_inertia.std),
+             pm(c.stiffness.value, c.stiffness.std), pm(c.shaft_damping.value, c.shaft_damping.std));
+}
+
 fit::FitOptions options_from(const FitArgs& a) {
   fit::FitOptions o;
   if (a.output_kind == "velocity")
@@ -133,9 +160,18 @@ int run(const FitArgs& a, const GlobalOptions& global) {
     nonlinear = fit::analyze_nonlinear_mechanics(fitted, experiments, options_from(a));
     print_nonlinear(*nonlinear);
   }
+  std::optional<fit::CoulombFit> friction;
+  if (a.friction) {
+    friction = fit::fit_coulomb_friction(response, fitted, options_from(a));
+    print_friction(*friction);
+  }
   if (!a.out.empty()) {
     auto out = open_output(a.out, global);
-    out->stream() << io::plant_model_to_json(fitted, nonlinear ? &*nonlinear : nullptr).dump(2) << "\n";
+    const fit::FitReport written = friction ? fit::with_friction_model(fitted, *friction) : fitted;
+    out->stream() << io::plant_model_to_json(written, nonlinear ? &*nonlinear : nullptr,
+                                             friction && friction->fitted ? &*friction : nullptr)
+                         .dump(2)
+                  << "\n";
     out->commit();
     progress(global, "wrote {} ({:.0f} ms)", a.out, elapsed_ms(start));
   }
@@ -180,10 +216,15 @@ void register_fit(CLI::App& app, Action& selected) {
                   "Responses of the same plant measured at other excitation amplitudes (the main file should be the "
                   "largest): Coulomb friction and backlash from their describing functions")
       ->check(CLI::ExistingFile);
+  cmd->add_flag("--friction", a->friction,
+                "Also fit Coulomb friction on motor and load with --model two-mass (describing functions at each "
+                "point's excitation amplitude, swept-sine responses): friction is told apart from the linear "
+                "damping, and -o writes the linear part");
   add_report_option(*cmd, a->report);
   set_examples(*cmd,
                "  servotwin fit frf.csv -o plant_model.json --report fit.html\n"
                "  servotwin fit frf.csv --model modes:2 --lag -o plant_model.json\n"
+               "  servotwin fit frf.csv --lag --friction -o plant_model.json\n"
                "  servotwin fit frf.csv --model auto --output-kind velocity --rigid integrator\n"
                "  servotwin fit frf_2Nm.csv --delay --amplitude-series frf_0.25Nm.csv -o plant_model.json\n");
   cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });

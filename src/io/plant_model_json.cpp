@@ -75,9 +75,23 @@ json nonlinear_json(const fit::NonlinearMechanics& n) {
             {"stiffness", n.backlash.stiffness}, {"note", n.backlash.note}, {"runs", runs}}}};
 }
 
+json friction_json(const fit::CoulombFit& c) {
+  return {{"model", "two-mass, Coulomb on motor and load"},
+          {"motor_coulomb", c.motor_coulomb.value},
+          {"motor_coulomb_std", number_or_null(c.motor_coulomb.std)},
+          {"load_coulomb", c.load_coulomb.value},
+          {"load_coulomb_std", number_or_null(c.load_coulomb.std)},
+          {"viscous_damping", c.viscous_damping.value},
+          {"viscous_damping_std", number_or_null(c.viscous_damping.std)},
+          {"residual", c.rms_log_error},
+          {"linear_residual", c.linear_rms_log_error},
+          {"note", c.note}};
+}
+
 }  // namespace
 
-json plant_model_to_json(const fit::FitReport& report, const fit::NonlinearMechanics* nonlinear) {
+json plant_model_to_json(const fit::FitReport& report, const fit::NonlinearMechanics* nonlinear,
+                         const fit::CoulombFit* friction) {
   const fit::FitResult& f = report.result;
   const fit::PlantModel& m = f.model;
   const core::TransferFunction tf = m.transfer_function();
@@ -135,6 +149,7 @@ json plant_model_to_json(const fit::FitReport& report, const fit::NonlinearMecha
           {"slope_db_per_decade", number_or_null(report.output.slope_db_per_decade)},
           {"note", report.output.note}}}}}};
   if (nonlinear) document["nonlinear"] = nonlinear_json(*nonlinear);
+  if (friction) document["friction"] = friction_json(*friction);
   return document;
 }
 
@@ -142,7 +157,7 @@ LoadedPlantModel parse_plant_model_json(std::string_view text, std::string_view 
   const json document = detail::parse_json_text(text, source_name);
   check_format(document, kPlantModelFormat, source_name);
   const JsonObject root(document, "", source_name);
-  root.allow_only({"format", "model", "modes", "physical", "physical_note", "fit", "selection", "nonlinear"});
+  root.allow_only({"format", "model", "modes", "physical", "physical_note", "fit", "selection", "nonlinear", "friction"});
   const JsonObject m = root.object("model");
   m.allow_only({"type", "output", "rigid", "gain", "gain_std", "rigid_pole_hz", "rigid_pole_hz_std", "lag_pole_hz",
                 "lag_pole_hz_std", "delay_s", "delay_s_std", "numerator", "denominator"});

@@ -17,6 +17,7 @@
 
 #include "servotwin/core/error.hpp"
 #include "servotwin/fit/fit.hpp"
+#include "servotwin/fit/friction_fit.hpp"
 #include "servotwin/machine/flexible_presets.hpp"
 #include "servotwin/vcnc/frf_experiment.hpp"
 
@@ -142,13 +143,19 @@ namespace {
 // marked invalid with its reason, and the fit leaves it out. The plant: the motor bench's
 // mechanics with Coulomb friction of 0.56 N m on both masses (half the start amplitude) and
 // noise 0.06 rad/s; at 1 Hz the motor sticks for part of each period (THD 0.155 at the latch).
-TEST(FrfExperiment, PointsOutsideTheirLimitsAreMarkedAndLeftOutOfTheFit) {
+/// The motor bench's mechanics with Coulomb friction `level` on both masses (no stiction) and
+/// noise 0.06 rad/s, no quantization (issue 25 §1's plants; the start amplitude is 1.12 N m).
+machine::PlantConfig bench_with_coulomb(double level) {
   machine::PlantConfig config = machine::flexible_preset("motor-bench");
   auto& chain = std::get<machine::MassChain>(config.model);
-  chain.friction = {machine::KarnoppFriction{0.56, std::nullopt, 0.005}, machine::KarnoppFriction{0.56, std::nullopt, 0.005}};
+  chain.friction = {machine::KarnoppFriction{level, std::nullopt, 0.005}, machine::KarnoppFriction{level, std::nullopt, 0.005}};
   config.settings.noise_std = 0.06;
   config.settings.quantization = 0.0;
-  machine::FlexiblePlant plant(config);
+  return config;
+}
+
+TEST(FrfExperiment, PointsOutsideTheirLimitsAreMarkedAndLeftOutOfTheFit) {
+  machine::FlexiblePlant plant(bench_with_coulomb(0.56));
   vcnc::FrfExperimentSettings settings;
   const auto parameters = vcnc::experiment_parameters(plant, settings);
   const auto e = vcnc::run_frf_experiment(plant, parameters, vcnc::time_limit(settings), false,
@@ -179,6 +186,37 @@ TEST(FrfExperiment, PointsOutsideTheirLimitsAreMarkedAndLeftOutOfTheFit) {
   EXPECT_EQ(all.result.points, e.response.size() - invalid);
   EXPECT_EQ(all.result.model.modes.front().antiresonance.omega_rad_s, valid.result.model.modes.front().antiresonance.omega_rad_s);
   EXPECT_EQ(all.result.model.gain, valid.result.model.gain);
+}
+
+// Issue 25 §1's targets with friction 1.5 and 3 times the start amplitude: the two-mass fit with
+// Coulomb friction (fit::fit_coulomb_friction) gives the antiresonance damping within 20 % and
+// the frequencies within 0.5 % where the linear fit's ζz is 60-110 % too large and it reads the
+// friction as a rigid pole of 0.6-0.8 Hz. Reference: the bench's own parameters (53.00 Hz,
+// ζz 0.0200, 76.0 Hz; viscous rigid pole 0.0048 Hz). Measured: ζz −3.6 % and −2.0 %, rigid pole
+// 0.07 and 0.09 Hz (± 0.03).
+TEST(FrfExperiment, FrictionFitSeparatesCoulombFrictionFromTheLinearDamping) {
+  for (double level : {1.68, 3.36}) {
+    const machine::PlantConfig config = bench_with_coulomb(level);
+    machine::FlexiblePlant plant(config);
+    vcnc::FrfExperimentSettings settings;
+    const auto e = vcnc::run_frf_experiment(plant, vcnc::experiment_parameters(plant, settings), vcnc::time_limit(settings),
+                                            false, vcnc::dc_hold_gain(plant, settings));
+    ASSERT_EQ(e.final_state, frf::RfidState::kDone) << vcnc::outcome_text(e);
+    fit::FitOptions o;
+    o.lag = true;
+    const fit::FitReport linear = fit::fit_plant(e.response, {fit::ModelRequest::Kind::kTwoMass, 1}, o);
+    const TrueModes truth = true_modes(config);
+    EXPECT_GT(linear.result.model.modes.front().antiresonance.zeta, 1.5 * truth.zeta_z) << level;  // what §1 found
+    const fit::CoulombFit c = fit::fit_coulomb_friction(e.response, linear, o);
+    ASSERT_TRUE(c.fitted) << c.note;
+    const fit::Mode& m = c.model.modes.front();
+    EXPECT_NEAR(m.antiresonance.omega_rad_s / kTwoPi / truth.fz_hz, 1.0, 0.005) << level;
+    EXPECT_NEAR(m.resonance.omega_rad_s / kTwoPi / truth.fn_hz, 1.0, 0.005) << level;
+    EXPECT_NEAR(m.antiresonance.zeta / truth.zeta_z, 1.0, 0.2) << level;
+    EXPECT_LT(c.model.rigid == fit::RigidKind::kRealPole ? c.model.rigid_pole_rad_s / kTwoPi : 0.0, 0.15) << level;
+    // Both masses carry `level`: the two levels' sum is what the low frequencies see.
+    EXPECT_NEAR((c.motor_coulomb.value + c.load_coulomb.value) / (2.0 * level), 1.0, 0.15) << level;
+  }
 }
 
 }  // namespace

@@ -24,6 +24,10 @@
 ///                                 "runs": [{"amplitude", "antiresonance_hz", "antiresonance_hz_std",
 ///                                           "effective_stiffness", "twist_amplitude"}]}}
 ///                   (only when responses at several amplitudes were given; read back as a record),
+///      "friction": {"model": "two-mass, Coulomb on motor and load", "motor_coulomb",
+///                   "motor_coulomb_std", "load_coulomb", "load_coulomb_std", "viscous_damping",
+///                   "viscous_damping_std", "residual", "linear_residual", "note"}
+///                   (`fit --friction`: "model", "modes" and "physical" then hold the linear part),
 ///      "selection": {"method", "criterion", "chosen_modes", "candidates": [{"modes",
 ///                    "parameters", "converged", "cost", "score"}],
 ///                    "output_detection": {"output", "detected", "slope_db_per_decade", "note"}}}
@@ -38,14 +42,16 @@
 #include <string_view>
 
 #include "servotwin/fit/fit.hpp"
+#include "servotwin/fit/friction_fit.hpp"
 #include "servotwin/fit/nonlinear.hpp"
 
 namespace servotwin::io {
 
 inline constexpr std::string_view kPlantModelFormat = "servotwin.plant-model/1";
 
-/// The whole report as a plant-model document.
-nlohmann::json plant_model_to_json(const fit::FitReport& report, const fit::NonlinearMechanics* nonlinear = nullptr);
+/// The whole report as a plant-model document; `friction` (a fitted CoulombFit) adds its record.
+nlohmann::json plant_model_to_json(const fit::FitReport& report, const fit::NonlinearMechanics* nonlinear = nullptr,
+                                   const fit::CoulombFit* friction = nullptr);
 
 /// What a plant-model file gives back.
 struct LoadedPlantModel {
