@@ -25,6 +25,7 @@ struct FitArgs {
   std::string model = "two-mass";
   std::string output_kind = "auto";
   std::string rigid = "pole";
+  std::string sensor = "motor";
   bool lag = false;
   bool delay = false;
   std::size_t max_modes = 4;
@@ -49,7 +50,8 @@ void print_summary(const std::string& source, const fit::FitReport& r) {
     fmt::print("left out {} point(s) (marked invalid by the measurement, or outliers of the first fit):\n", r.left_out.size());
     for (const std::string& why : r.left_out) fmt::print("  {}\n", why);
   }
-  fmt::print("model: {} mode(s), rigid {}{}{}; {}\n", m.modes.size(), fit::to_string(m.rigid),
+  fmt::print("model: {} {}mode(s), rigid {}{}{}; {}\n", m.modes.size(), m.sensor == fit::SensorSide::kLoad ? "load-side " : "",
+             fit::to_string(m.rigid),
              m.lag_pole_rad_s ? ", lag pole" : "", m.delay_s ? ", delay" : "", r.selection.criterion);
   if (r.selection.method == "auto")
     for (const auto& c : r.selection.candidates)
@@ -66,10 +68,13 @@ void print_summary(const std::string& source, const fit::FitReport& r) {
   if (m.delay_s) fmt::print("  delay           = {} s\n", pm(f.delay_s.value, f.delay_s.std));
   for (std::size_t i = 0; i < f.mode_estimates.size(); ++i) {
     const auto& u = f.mode_estimates[i];
-    fmt::print("  mode {}: antiresonance {} Hz, zeta {}\n", i + 1, pm(u.antiresonance_omega.value / kTwoPi, u.antiresonance_omega.std / kTwoPi),
-               pm(u.antiresonance_zeta.value, u.antiresonance_zeta.std));
-    fmt::print("          resonance     {} Hz, zeta {}\n", pm(u.resonance_omega.value / kTwoPi, u.resonance_omega.std / kTwoPi),
-               pm(u.resonance_zeta.value, u.resonance_zeta.std));
+    if (m.sensor == fit::SensorSide::kMotor)
+      fmt::print("  mode {}: antiresonance {} Hz, zeta {}\n", i + 1,
+                 pm(u.antiresonance_omega.value / kTwoPi, u.antiresonance_omega.std / kTwoPi),
+                 pm(u.antiresonance_zeta.value, u.antiresonance_zeta.std));
+    fmt::print("  {:<8}resonance     {} Hz, zeta {}\n",
+               m.sensor == fit::SensorSide::kMotor ? "" : fmt::format("mode {}:", i + 1),
+               pm(u.resonance_omega.value / kTwoPi, u.resonance_omega.std / kTwoPi), pm(u.resonance_zeta.value, u.resonance_zeta.std));
   }
   if (const auto& p = f.physical.parameters) {
     fmt::print("physical two-mass parameters (input/output units of the data):\n");
@@ -114,10 +119,16 @@ void print_friction(const fit::CoulombFit& c) {
                pm(c.rigid_pole_rad_s.value / kTwoPi, c.rigid_pole_rad_s.std / kTwoPi), c.viscous_damping.value);
   else
     fmt::print("  rigid           = integrator (no viscous damping found)\n");
-  fmt::print("  mode 1: antiresonance {} Hz, zeta {}\n", pm(m.antiresonance.omega_rad_s / kTwoPi, c.mode.antiresonance_omega.std / kTwoPi),
-             pm(m.antiresonance.zeta, c.mode.antiresonance_zeta.std));
-  fmt::print("          resonance     {} Hz, zeta {}\n", pm(m.resonance.omega_rad_s / kTwoPi, c.mode.resonance_omega.std / kTwoPi),
-             pm(m.resonance.zeta, c.mode.resonance_zeta.std));
+  if (c.model.sensor == fit::SensorSide::kMotor)
+    fmt::print("  mode 1: antiresonance {} Hz, zeta {}\n", pm(m.antiresonance.omega_rad_s / kTwoPi, c.mode.antiresonance_omega.std / kTwoPi),
+               pm(m.antiresonance.zeta, c.mode.antiresonance_zeta.std));
+  fmt::print("  {:<8}resonance     {} Hz, zeta {}\n", c.model.sensor == fit::SensorSide::kMotor ? "" : "mode 1:",
+             pm(m.resonance.omega_rad_s / kTwoPi, c.mode.resonance_omega.std / kTwoPi), pm(m.resonance.zeta, c.mode.resonance_zeta.std));
+  if (c.model.sensor == fit::SensorSide::kLoad) {
+    fmt::print("  total inertia J = {}, motor's share Jm/J = {} (seen through the friction only)\n",
+               pm(c.total_inertia.value, c.total_inertia.std), pm(c.motor_share.value, c.motor_share.std));
+    return;
+  }
   fmt::print("  motor inertia Im = {}\n  load inertia  Il = {}\n  stiffness     k  = {}\n  shaft damping b  = {}\n",
              pm(c.motor_inertia.value, c.motor_inertia.std), pm(c.load_inertia.value, c.load_inertia.std),
              pm(c.stiffness.value, c.stiffness.std), pm(c.shaft_damping.value, c.shaft_damping.std));
@@ -132,6 +143,7 @@ fit::FitOptions options_from(const FitArgs& a) {
   else
     o.output = fit::OutputChoice::kDetect;
   o.rigid = a.rigid == "integrator" ? fit::RigidKind::kIntegrator : fit::RigidKind::kRealPole;
+  o.sensor = a.sensor == "load" ? fit::SensorSide::kLoad : fit::SensorSide::kMotor;
   o.lag = a.lag;
   o.delay = a.delay;
   o.max_modes = a.max_modes;
@@ -142,6 +154,11 @@ fit::FitOptions options_from(const FitArgs& a) {
 int run(const FitArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   const fit::ModelRequest request = fit::parse_model_request(a.model);
+  if (a.sensor == "load" && !a.amplitude_series.empty())
+    throw core::InputError(core::at_field("--amplitude-series"),
+                           "the amplitude-series analysis of friction and backlash reads the motor side's antiresonance, "
+                           "which a load-side response (--sensor load) does not have: use --friction, or measure with "
+                           "the motor encoder");
   const core::FrequencyResponse response = io::read_frf_file(a.frf);
   const auto report_file = open_report(a.report, global);
   fit::FitReport fitted;
@@ -165,9 +182,9 @@ int run(const FitArgs& a, const GlobalOptions& global) {
     friction = fit::fit_coulomb_friction(response, fitted, options_from(a));
     print_friction(*friction);
   }
+  const fit::FitReport written = friction ? fit::with_friction_model(fitted, *friction) : fitted;
   if (!a.out.empty()) {
     auto out = open_output(a.out, global);
-    const fit::FitReport written = friction ? fit::with_friction_model(fitted, *friction) : fitted;
     out->stream() << io::plant_model_to_json(written, nonlinear ? &*nonlinear : nullptr,
                                              friction && friction->fitted ? &*friction : nullptr)
                          .dump(2)
@@ -176,7 +193,8 @@ int run(const FitArgs& a, const GlobalOptions& global) {
     progress(global, "wrote {} ({:.0f} ms)", a.out, elapsed_ms(start));
   }
   if (report_file)
-    write_report(report::fit_report(response, fitted, a.frf, nonlinear ? &*nonlinear : nullptr), *report_file, global);
+    write_report(report::fit_report(response, written, a.frf, nonlinear ? &*nonlinear : nullptr, friction ? &*friction : nullptr),
+                 *report_file, global);
   return kSuccess;
 }
 
@@ -198,6 +216,11 @@ void register_fit(CLI::App& app, Action& selected) {
   cmd->add_option("--rigid", a->rigid, "Rigid-body mode: pole (K/(s+a), viscous friction) or integrator (K/s)")
       ->check(CLI::IsMember({"pole", "integrator"}))
       ->capture_default_str();
+  cmd->add_option("--sensor", a->sensor,
+                  "Where the response was measured: motor (collocated: each mode an antiresonance and its resonance) "
+                  "or load (a load encoder: resonances alone, each with the shaft's damping zero)")
+      ->check(CLI::IsMember({"motor", "load"}))
+      ->capture_default_str();
   cmd->add_flag("--lag", a->lag, "Also fit a lag pole 1/(s+tau2) (sampling, communication and actuator lag)");
   cmd->add_flag("--delay", a->delay, "Also fit a pure delay exp(-sT)");
   cmd->add_option("--max-modes", a->max_modes, "Largest number of modes tried by --model auto")
@@ -218,13 +241,14 @@ void register_fit(CLI::App& app, Action& selected) {
       ->check(CLI::ExistingFile);
   cmd->add_flag("--friction", a->friction,
                 "Also fit Coulomb friction on motor and load with --model two-mass (describing functions at each "
-                "point's excitation amplitude, swept-sine responses): friction is told apart from the linear "
-                "damping, and -o writes the linear part");
+                "point's excitation amplitude, swept-sine responses; either --sensor): friction is told apart from "
+                "the linear damping, and -o writes the linear part");
   add_report_option(*cmd, a->report);
   set_examples(*cmd,
                "  servotwin fit frf.csv -o plant_model.json --report fit.html\n"
                "  servotwin fit frf.csv --model modes:2 --lag -o plant_model.json\n"
                "  servotwin fit frf.csv --lag --friction -o plant_model.json\n"
+               "  servotwin fit load_frf.csv --sensor load --lag -o load_model.json\n"
                "  servotwin fit frf.csv --model auto --output-kind velocity --rigid integrator\n"
                "  servotwin fit frf_2Nm.csv --delay --amplitude-series frf_0.25Nm.csv -o plant_model.json\n");
   cmd->callback([a, &selected] { selected = [a](const GlobalOptions& g) { return run(*a, g); }; });

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <fmt/format.h>
 #include <limits>
 #include <numbers>
 #include <numeric>
@@ -13,6 +12,7 @@
 #include "servotwin/core/error.hpp"
 #include "servotwin/core/levenberg_marquardt.hpp"
 #include "servotwin/fit/initialization.hpp"
+#include "misfit.hpp"
 
 namespace servotwin::fit {
 
@@ -46,29 +46,13 @@ bool has_invalid(const core::FrequencyResponse& response) {
   return std::any_of(response.points.begin(), response.points.end(), [](const auto& p) { return !p.valid; });
 }
 
-/// The standard deviation a point is weighted with: its measured one, inflated by its harmonic
-/// distortion on a swept-sine response (issue 25 §1): a point with THD q carries harmonics of q
-/// times the fundamental, the mark of a nonlinearity (friction, backlash) whose describing function
-/// departs from the linear plant by that order, so σ_eff² = σ² + (q|P|)²/2 (the distortion counted
-/// as one more circular error of relative size q/√2). Noise-free THD (q ≈ 0) leaves σ as measured.
-/// Only where every point has its std: swept-sine points carry SNR, not std, and weighting them by
-/// |P|/SNR was tried and moved the backlash and E14 estimates out of their tolerances (the block's
-/// SNR is the observer's, not the value's), so such a response keeps log-relative weights.
-double effective_std(const core::FrequencyPoint& p, core::QualityKind kind) {
-  if (kind != core::QualityKind::kThd || !(p.quality > 0.0)) return p.std_dev;
-  const double distortion = p.quality * std::abs(p.value);
-  return std::sqrt(p.std_dev * p.std_dev + 0.5 * distortion * distortion);
-}
-
 Data make_data(const core::FrequencyResponse& response) {
   Data d;
   d.known_std = std::all_of(response.points.begin(), response.points.end(), [](const auto& p) { return p.std_dev > 0.0; });
   for (const auto& p : response.points) {
     d.omega.push_back(kTwoPi * p.freq_hz);
     d.log_meas.push_back(std::log(p.value));
-    // std_dev is the circular complex standard deviation (E|δ|² = σ²), so each of Re and Im of
-    // δ/P has standard deviation σ/(√2|P|).
-    d.weight.push_back(d.known_std ? std::sqrt(2.0) * std::abs(p.value) / effective_std(p, response.quality_kind) : 1.0);
+    d.weight.push_back(detail::log_residual_weight(p, response.quality_kind, d.known_std));
   }
   return d;
 }
@@ -126,25 +110,33 @@ std::vector<std::size_t> outliers(const core::FrequencyResponse& response, const
 // ---- parameterization -------------------------------------------------------------------------
 
 /// Position of each parameter in θ.
+/// Position of each parameter in θ. A motor-side mode is (ln ωz, ln ζz, ln ωp, ln ζp), a
+/// load-side one (ln ωp, ln ζp).
 struct Layout {
   std::size_t modes = 0;
   RigidKind rigid = RigidKind::kRealPole;
   OutputKind output = OutputKind::kVelocity;
   bool lag = false, delay = false;
+  SensorSide sensor = SensorSide::kMotor;
 
+  [[nodiscard]] Eigen::Index per_mode() const { return sensor == SensorSide::kMotor ? 4 : 2; }
   [[nodiscard]] Eigen::Index rigid_index() const { return 1; }
   [[nodiscard]] Eigen::Index mode_base(std::size_t i) const {
-    return static_cast<Eigen::Index>(1 + (rigid == RigidKind::kRealPole ? 1 : 0) + 4 * i);
+    return static_cast<Eigen::Index>(1 + (rigid == RigidKind::kRealPole ? 1 : 0)) + per_mode() * static_cast<Eigen::Index>(i);
+  }
+  /// θ index of mode i's ln ωp.
+  [[nodiscard]] Eigen::Index resonance_index(std::size_t i) const {
+    return mode_base(i) + (sensor == SensorSide::kMotor ? 2 : 0);
   }
   [[nodiscard]] Eigen::Index lag_index() const { return mode_base(modes); }
   [[nodiscard]] Eigen::Index delay_index() const { return mode_base(modes) + (lag ? 1 : 0); }
   [[nodiscard]] Eigen::Index size() const {
-    return static_cast<Eigen::Index>(parameter_count(modes, rigid, lag, delay));
+    return static_cast<Eigen::Index>(parameter_count(modes, rigid, lag, delay, sensor));
   }
 };
 
 Layout layout_of(const PlantModel& m) {
-  return Layout{m.modes.size(), m.rigid, m.output, m.lag_pole_rad_s.has_value(), m.delay_s.has_value()};
+  return Layout{m.modes.size(), m.rigid, m.output, m.lag_pole_rad_s.has_value(), m.delay_s.has_value(), m.sensor};
 }
 
 std::vector<std::string> parameter_names(const Layout& l) {
@@ -152,7 +144,9 @@ std::vector<std::string> parameter_names(const Layout& l) {
   if (l.rigid == RigidKind::kRealPole) names.emplace_back("ln_rigid_pole");
   for (std::size_t i = 0; i < l.modes; ++i) {
     const std::string p = "mode" + std::to_string(i + 1) + ".";
-    for (const char* s : {"ln_wz", "ln_zeta_z", "ln_wp", "ln_zeta_p"}) names.push_back(p + s);
+    if (l.sensor == SensorSide::kMotor)
+      for (const char* s : {"ln_wz", "ln_zeta_z"}) names.push_back(p + s);
+    for (const char* s : {"ln_wp", "ln_zeta_p"}) names.push_back(p + s);
   }
   if (l.lag) names.emplace_back("ln_lag_pole");
   if (l.delay) names.emplace_back("ln_delay");
@@ -165,11 +159,13 @@ Eigen::VectorXd to_theta(const PlantModel& m) {
   t[0] = std::log(std::abs(m.gain));
   if (l.rigid == RigidKind::kRealPole) t[l.rigid_index()] = std::log(m.rigid_pole_rad_s);
   for (std::size_t i = 0; i < l.modes; ++i) {
-    const Eigen::Index b = l.mode_base(i);
-    t[b] = std::log(m.modes[i].antiresonance.omega_rad_s);
-    t[b + 1] = std::log(m.modes[i].antiresonance.zeta);
-    t[b + 2] = std::log(m.modes[i].resonance.omega_rad_s);
-    t[b + 3] = std::log(m.modes[i].resonance.zeta);
+    const Eigen::Index b = l.mode_base(i), p = l.resonance_index(i);
+    if (l.sensor == SensorSide::kMotor) {
+      t[b] = std::log(m.modes[i].antiresonance.omega_rad_s);
+      t[b + 1] = std::log(m.modes[i].antiresonance.zeta);
+    }
+    t[p] = std::log(m.modes[i].resonance.omega_rad_s);
+    t[p + 1] = std::log(m.modes[i].resonance.zeta);
   }
   if (l.lag) t[l.lag_index()] = std::log(*m.lag_pole_rad_s);
   if (l.delay) t[l.delay_index()] = std::log(*m.delay_s);
@@ -180,11 +176,13 @@ PlantModel to_model(const Eigen::VectorXd& t, const Layout& l, double sign) {
   PlantModel m;
   m.output = l.output;
   m.rigid = l.rigid;
+  m.sensor = l.sensor;
   m.gain = sign * std::exp(t[0]);
   if (l.rigid == RigidKind::kRealPole) m.rigid_pole_rad_s = std::exp(t[l.rigid_index()]);
   for (std::size_t i = 0; i < l.modes; ++i) {
-    const Eigen::Index b = l.mode_base(i);
-    m.modes.push_back(Mode{{std::exp(t[b]), std::exp(t[b + 1])}, {std::exp(t[b + 2]), std::exp(t[b + 3])}});
+    const Eigen::Index b = l.mode_base(i), p = l.resonance_index(i);
+    const ModalPair zeros = l.sensor == SensorSide::kMotor ? ModalPair{std::exp(t[b]), std::exp(t[b + 1])} : ModalPair{};
+    m.modes.push_back(Mode{zeros, {std::exp(t[p]), std::exp(t[p + 1])}});
   }
   if (l.lag) m.lag_pole_rad_s = std::exp(t[l.lag_index()]);
   if (l.delay) m.delay_s = std::exp(t[l.delay_index()]);
@@ -211,14 +209,22 @@ bool log_residuals(const Eigen::VectorXd& t, const Layout& l, double sign, const
     }
     for (std::size_t i = 0; i < l.modes; ++i) {
       const Eigen::Index b = l.mode_base(i);
-      for (int pole = 0; pole < 2; ++pole) {
-        const Eigen::Index j = b + 2 * pole;
+      for (int pole = l.sensor == SensorSide::kMotor ? 0 : 1; pole < 2; ++pole) {
+        const Eigen::Index j = l.sensor == SensorSide::kMotor ? b + 2 * pole : b;
         const double w = std::exp(t[j]), z = std::exp(t[j + 1]);
         const Complex q = s * s + 2.0 * z * w * s + w * w;
         const double sgn = pole ? -1.0 : 1.0;
         log_p += sgn * std::log(q);
         d[j] = sgn * (2.0 * z * w * s + 2.0 * w * w) / q;
         d[j + 1] = sgn * (2.0 * z * w * s) / q;
+      }
+      if (l.sensor == SensorSide::kLoad) {
+        // The shaft's damping zero 2ζω s + ω² (plant_model.hpp), tied to the resonance.
+        const double w = std::exp(t[b]), z = std::exp(t[b + 1]);
+        const Complex zero = 2.0 * z * w * s + w * w;
+        log_p += std::log(zero);
+        d[b] += (2.0 * z * w * s + 2.0 * w * w) / zero;
+        d[b + 1] += (2.0 * z * w * s) / zero;
       }
     }
     if (l.lag) {
@@ -367,8 +373,8 @@ void canonicalize(Eigen::VectorXd& t, Eigen::MatrixXd& c, const Layout& l) {
   for (std::size_t pass = 0; pass < l.modes; ++pass)
     for (std::size_t i = 0; i + 1 < l.modes; ++i) {
       const Eigen::Index a = l.mode_base(i), b = l.mode_base(i + 1);
-      if (t[a + 2] > t[b + 2])
-        for (Eigen::Index k = 0; k < 4; ++k) swap_parameters(t, c, a + k, b + k);
+      if (t[l.resonance_index(i)] > t[l.resonance_index(i + 1)])
+        for (Eigen::Index k = 0; k < l.per_mode(); ++k) swap_parameters(t, c, a + k, b + k);
     }
 }
 
@@ -377,41 +383,22 @@ Estimate log_estimate(const Eigen::VectorXd& t, const Eigen::MatrixXd& c, Eigen:
   return {v, std::abs(v) * std::sqrt(c(i, i))};
 }
 
-/// The covariance factor of FitResult::uncertainty_scale, with its note.
-std::pair<double, std::string> misfit_scale(const Run& run, const Layout& l, const Data& data) {
+/// The covariance factor of FitResult::uncertainty_scale, with its note (detail::misfit_scale).
+detail::MisfitScale misfit_scale(const Run& run, const Layout& l, const Data& data) {
   const std::size_t m = data.size();
   const double dof = 2.0 * static_cast<double>(m) - static_cast<double>(l.size());
   Eigen::VectorXd r(static_cast<Eigen::Index>(2 * m));
-  if (dof <= 0.0 || m < 3 || !log_residuals(run.theta, l, run.sign, data, r, nullptr)) return {1.0, {}};
-  double lag0 = 0.0, lag1 = 0.0;
-  for (Eigen::Index k = 0; k < r.size(); ++k) {
-    lag0 += r[k] * r[k];
-    if (k + 2 < r.size()) lag1 += r[k] * r[k + 2];  // the same part (Re or Im) of the next point
-  }
-  const double rho = lag0 > 0.0 ? std::clamp(lag1 / lag0, 0.0, 0.98) : 0.0;
-  const double kappa = (1.0 + rho) / (1.0 - rho);
-  const bool correlated = rho > 2.0 / std::sqrt(static_cast<double>(m));
-  if (data.known_std) {
-    const double s = r.squaredNorm() / dof;
-    if (!(s > 1.0 + 3.0 * std::sqrt(2.0 / dof))) return {1.0, {}};
-    return {s * kappa, fmt::format("standard deviations scaled by {:.3g}: the misfit is {:.3g} times the measured "
-                                   "noise (reduced chi-square {:.3g}) and neighbouring residuals correlate "
-                                   "(rho {:.2f}), so the noise alone would understate them",
-                                   std::sqrt(s * kappa), std::sqrt(s), s, rho)};
-  }
-  if (!correlated) return {1.0, {}};
-  return {kappa, fmt::format("standard deviations scaled by {:.3g}: neighbouring residuals correlate (rho {:.2f}), a "
-                             "systematic misfit",
-                             std::sqrt(kappa), rho)};
+  if (dof <= 0.0 || m < 3 || !log_residuals(run.theta, l, run.sign, data, r, nullptr)) return {};
+  return detail::misfit_scale(r, dof, data.known_std);
 }
 
 FitResult finish(const Run& run, const Layout& l, const Data& data) {
   FitResult f;
   Eigen::VectorXd t = run.theta;
-  const auto [scale, note] = misfit_scale(run, l, data);
-  Eigen::MatrixXd c = run.lm.covariance * scale;
-  f.uncertainty_scale = scale;
-  f.uncertainty_note = note;
+  const detail::MisfitScale misfit = misfit_scale(run, l, data);
+  Eigen::MatrixXd c = run.lm.covariance * misfit.factor;
+  f.uncertainty_scale = misfit.factor;
+  f.uncertainty_note = misfit.note;
   canonicalize(t, c, l);
   f.model = to_model(t, l, run.sign);
   f.converged = run.lm.converged();
@@ -437,11 +424,18 @@ FitResult finish(const Run& run, const Layout& l, const Data& data) {
   f.lag_pole_rad_s = l.lag ? log_estimate(t, c, l.lag_index()) : Estimate{kNan, kNan};
   f.delay_s = l.delay ? log_estimate(t, c, l.delay_index()) : Estimate{kNan, kNan};
   for (std::size_t i = 0; i < l.modes; ++i) {
-    const Eigen::Index b = l.mode_base(i);
-    f.mode_estimates.push_back({log_estimate(t, c, b), log_estimate(t, c, b + 1), log_estimate(t, c, b + 2),
-                                log_estimate(t, c, b + 3)});
+    const Eigen::Index b = l.mode_base(i), p = l.resonance_index(i);
+    const bool motor = l.sensor == SensorSide::kMotor;
+    f.mode_estimates.push_back({motor ? log_estimate(t, c, b) : Estimate{kNan, kNan},
+                                motor ? log_estimate(t, c, b + 1) : Estimate{kNan, kNan}, log_estimate(t, c, p),
+                                log_estimate(t, c, p + 1)});
   }
-  if (l.modes == 1) {
+  if (l.sensor == SensorSide::kLoad) {
+    f.physical.note = "no two-mass parameters from a load-side response: its low-frequency gain gives the total inertia "
+                      "(1/K" + std::string(l.lag ? "' = tau2/K" : "") + " = " +
+                      num(l.lag ? std::exp(t[l.lag_index()]) / std::abs(f.model.gain) : 1.0 / std::abs(f.model.gain), 6) +
+                      "), the split between motor and load needs the motor side's antiresonance";
+  } else if (l.modes == 1) {
     const Eigen::Index b = l.mode_base(0);
     // u = (ln K', ln ωz, ln ζz, ln ωn) with K' = K/τ2 when there is a lag (its DC gain 1/τ2
     // belongs to the gain the motor inertia is read from): u = T θ, cov(u) = T C Tᵀ.
@@ -568,7 +562,8 @@ PhysicalExtraction two_mass_parameters(const PlantModel& model, const Eigen::Mat
     return out;
   }
   const double im = 1.0 / k1, il = im * (r * r - 1.0), k = il * wz * wz, b = 2.0 * zz * wz * il;
-  // Delta method: gradients with respect to u = (ln K, ln ωz, ln ζz, ln ωn).
+  // Delta method: gradients with respect to u = (ln K', ln ωz, ln ζz, ln ωn), K' = K/τ2 with a lag
+  // (the caller transforms θ's covariance to u), else K.
   auto with_std = [&](double v, const Eigen::Vector4d& g) { return Estimate{v, std::sqrt(g.dot(log_covariance * g))}; };
   TwoMassParameters p;
   p.motor_inertia = with_std(im, Eigen::Vector4d(-im, 0.0, 0.0, 0.0));
@@ -578,7 +573,8 @@ PhysicalExtraction two_mass_parameters(const PlantModel& model, const Eigen::Mat
   p.resonance_ratio = with_std(r, Eigen::Vector4d(0.0, -r, 0.0, r));
   p.damping_consistency = zn / (r * zz);
   out.parameters = p;
-  out.note = "two-mass parameters from K = 1/Im, antiresonance and resonance (r = " + num(r) + ")";
+  out.note = std::string("two-mass parameters from ") + (model.lag_pole_rad_s ? "K/tau2" : "K") +
+             " = 1/Im, antiresonance and resonance (r = " + num(r) + ")";
   return out;
 }
 
@@ -595,14 +591,31 @@ FitResult fit_model(const core::FrequencyResponse& response, std::size_t modes, 
                     const FitOptions& options) {
   validate_response(response);
   if (has_invalid(response)) return fit_model(response.valid_only(), modes, output, options);
-  const Layout l{modes, options.rigid, output, options.lag, options.delay};
-  const std::string what = modes == 1 ? "the two-mass model" : "a model with " + std::to_string(modes) + " modes";
+  const Layout l{modes, options.rigid, output, options.lag, options.delay, options.sensor};
+  const bool load = options.sensor == SensorSide::kLoad;
+  const std::string what = modes == 1 && !load ? "the two-mass model"
+                                               : "a model with " + std::to_string(modes) + (load ? " load-side" : "") + " modes";
   require_enough_points(response.size(), static_cast<std::size_t>(l.size()), what);
   const Data data = make_data(response);
 
   std::vector<std::pair<PlantModel, std::string>> starts;
   std::string failures;
-  if (modes > 0) {
+  if (modes > 0 && load) {
+    // A load-side response has maxima only (plant_model.hpp): peak picking gives the resonances.
+    const PeakPicking peaks = pick_peaks(response, output);
+    const auto choices = resonance_choices(peaks, modes);
+    if (choices.empty())
+      failures += "peak picking: " + std::to_string(peaks.resonances.size()) + " resonance(s) found, " +
+                  std::to_string(modes) + " needed; ";
+    for (auto choice : choices) {
+      std::sort(choice.begin(), choice.end(), [](const Extremum& a, const Extremum& b) { return a.omega_rad_s < b.omega_rad_s; });
+      PlantModel m;
+      m.rigid = options.rigid;
+      m.sensor = SensorSide::kLoad;
+      for (const Extremum& res : choice) m.modes.push_back(Mode{{}, {res.omega_rad_s, res.zeta}});
+      starts.emplace_back(complete_start(m, options.rigid == RigidKind::kRealPole, l, data), "peak-picking");
+    }
+  } else if (modes > 0) {
     const PeakPicking peaks = pick_peaks(response, output);
     const auto choices = resonance_choices(peaks, modes);
     if (choices.empty()) failures += "peak picking: " + pair_modes(peaks, modes).failure + "; ";
@@ -622,6 +635,7 @@ FitResult fit_model(const core::FrequencyResponse& response, std::size_t modes, 
   } else {
     PlantModel m;
     m.rigid = options.rigid;
+    m.sensor = options.sensor;
     starts.emplace_back(complete_start(m, options.rigid == RigidKind::kRealPole, l, data), "rigid");
   }
   if (starts.empty()) {
@@ -629,7 +643,9 @@ FitResult fit_model(const core::FrequencyResponse& response, std::size_t modes, 
     f.points = response.size();
     f.parameters = static_cast<std::size_t>(l.size());
     f.message = "no starting point: " + failures.substr(0, failures.size() - 2);
-    f.physical.note = modes == 1 ? "not a two-mass system: no resonance/antiresonance pair found in the data" : "";
+    f.physical.note = modes == 1 && !load ? "not a two-mass system: no resonance/antiresonance pair found in the data "
+                                            "(a load encoder's response has no antiresonance: fit it with the load sensor)"
+                                          : "";
     return f;
   }
   std::optional<Run> best;
@@ -678,11 +694,18 @@ FitReport fit_plant(const core::FrequencyResponse& response, const ModelRequest&
   validate_response(response);
   if (has_invalid(response)) {
     FitReport report = fit_plant(response.valid_only(), request, options);
+    std::vector<std::pair<double, std::string>> left;
+    for (std::size_t k = 0; k < report.left_out.size(); ++k) left.emplace_back(report.left_out_hz[k], report.left_out[k]);
     for (const auto& p : response.points)
-      if (!p.valid) report.left_out.push_back(num(p.freq_hz, 6) + " Hz: " + (p.note.empty() ? "marked invalid" : p.note));
+      if (!p.valid) left.emplace_back(p.freq_hz, num(p.freq_hz, 6) + " Hz: " + (p.note.empty() ? "marked invalid" : p.note));
     // Invalid points and the refit's outliers in one frequency order.
-    std::stable_sort(report.left_out.begin(), report.left_out.end(),
-                     [](const std::string& a, const std::string& b) { return std::stod(a) < std::stod(b); });
+    std::stable_sort(left.begin(), left.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    report.left_out.clear();
+    report.left_out_hz.clear();
+    for (auto& [hz, why] : left) {
+      report.left_out_hz.push_back(hz);
+      report.left_out.push_back(std::move(why));
+    }
     return report;
   }
   FitReport report;
@@ -714,7 +737,7 @@ FitReport fit_plant(const core::FrequencyResponse& response, const ModelRequest&
     const auto found = static_cast<std::size_t>(std::count_if(peaks.resonances.begin(), peaks.resonances.end(),
                                                               [&](const Extremum& e) { return e.prominence >= threshold; }));
     std::size_t top = std::min(options.max_modes, found);
-    while (top > 0 && 2 * m <= parameter_count(top, options.rigid, options.lag, options.delay)) --top;
+    while (top > 0 && 2 * m <= parameter_count(top, options.rigid, options.lag, options.delay, options.sensor)) --top;
     for (std::size_t n = 0; n <= top; ++n) orders.push_back(n);
     require_enough_points(m, parameter_count(0, options.rigid, options.lag, options.delay), "the rigid model");
     report.selection.criterion =

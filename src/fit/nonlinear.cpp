@@ -194,6 +194,7 @@ BacklashEstimate estimate_backlash(const FitReport& linear, std::span<const core
 
 NonlinearMechanics analyze_nonlinear_mechanics(const FitReport& linear, std::span<const core::FrequencyResponse> experiments,
                                                const FitOptions& options) {
+  require_motor_side(linear.result.model, "the amplitude-series analysis of friction and backlash", "--amplitude-series");
   // The amplitude series measures the distortion itself: points the measurement marked invalid
   // for their THD or SNR are its data here (the linear fit has left them out already).
   std::vector<core::FrequencyResponse> every_point(experiments.begin(), experiments.end());

@@ -83,6 +83,8 @@ json friction_json(const fit::CoulombFit& c) {
           {"load_coulomb_std", number_or_null(c.load_coulomb.std)},
           {"viscous_damping", c.viscous_damping.value},
           {"viscous_damping_std", number_or_null(c.viscous_damping.std)},
+          {"total_inertia", c.total_inertia.value},
+          {"total_inertia_std", number_or_null(c.total_inertia.std)},
           {"residual", c.rms_log_error},
           {"linear_residual", c.linear_rms_log_error},
           {"note", c.note}};
@@ -98,6 +100,7 @@ json plant_model_to_json(const fit::FitReport& report, const fit::NonlinearMecha
   json model = {{"type", model_type(m.modes.size())},
                 {"output", fit::to_string(m.output)},
                 {"rigid", fit::to_string(m.rigid)},
+                {"sensor", fit::to_string(m.sensor)},
                 {"gain", m.gain},
                 {"gain_std", number_or_null(f.gain.std)}};
   const bool pole = m.rigid == fit::RigidKind::kRealPole;
@@ -118,7 +121,8 @@ json plant_model_to_json(const fit::FitReport& report, const fit::NonlinearMecha
                   {"freq_hz", p.omega_rad_s / kTwoPi}, {"zeta", p.zeta},
                   {"freq_hz_std", number_or_null(w.std / kTwoPi)}, {"zeta_std", number_or_null(z.std)}};
     };
-    modes.push_back(entry("antiresonance", m.modes[i].antiresonance, u.antiresonance_omega, u.antiresonance_zeta));
+    if (m.sensor == fit::SensorSide::kMotor)
+      modes.push_back(entry("antiresonance", m.modes[i].antiresonance, u.antiresonance_omega, u.antiresonance_zeta));
     modes.push_back(entry("resonance", m.modes[i].resonance, u.resonance_omega, u.resonance_zeta));
   }
 
@@ -159,7 +163,7 @@ LoadedPlantModel parse_plant_model_json(std::string_view text, std::string_view 
   const JsonObject root(document, "", source_name);
   root.allow_only({"format", "model", "modes", "physical", "physical_note", "fit", "selection", "nonlinear", "friction"});
   const JsonObject m = root.object("model");
-  m.allow_only({"type", "output", "rigid", "gain", "gain_std", "rigid_pole_hz", "rigid_pole_hz_std", "lag_pole_hz",
+  m.allow_only({"type", "output", "rigid", "sensor", "gain", "gain_std", "rigid_pole_hz", "rigid_pole_hz_std", "lag_pole_hz",
                 "lag_pole_hz_std", "delay_s", "delay_s_std", "numerator", "denominator"});
   LoadedPlantModel out;
   fit::PlantModel& model = out.model;
@@ -169,6 +173,10 @@ LoadedPlantModel parse_plant_model_json(std::string_view text, std::string_view 
   const std::string rigid = m.string("rigid");
   if (rigid != "pole" && rigid != "integrator") m.fail("rigid", "expected \"pole\" or \"integrator\", got \"" + rigid + "\"");
   model.rigid = rigid == "pole" ? fit::RigidKind::kRealPole : fit::RigidKind::kIntegrator;
+  const std::string sensor = m.string_or("sensor", "motor");
+  if (sensor != "motor" && sensor != "load") m.fail("sensor", "expected \"motor\" or \"load\", got \"" + sensor + "\"");
+  model.sensor = sensor == "motor" ? fit::SensorSide::kMotor : fit::SensorSide::kLoad;
+  const bool load = model.sensor == fit::SensorSide::kLoad;
   model.gain = m.number("gain");
   if (model.gain == 0.0) m.fail("gain", "expected a non-zero gain");
   if (model.rigid == fit::RigidKind::kRealPole) model.rigid_pole_rad_s = kTwoPi * positive(m, "rigid_pole_hz");
@@ -183,18 +191,24 @@ LoadedPlantModel parse_plant_model_json(std::string_view text, std::string_view 
 
   const json& modes = document.at("modes");
   if (!modes.is_array()) root.fail("modes", "expected an array");
-  if (modes.size() % 2 != 0) root.fail("modes", "expected an antiresonance and a resonance entry per mode");
-  for (std::size_t i = 0; i < modes.size(); i += 2) {
+  // A motor-side mode is an antiresonance entry and a resonance entry, a load-side one a resonance.
+  const std::size_t per_mode = load ? 1 : 2;
+  if (modes.size() % per_mode != 0) root.fail("modes", "expected an antiresonance and a resonance entry per mode");
+  for (std::size_t i = 0; i < modes.size(); i += per_mode) {
     fit::Mode mode;
-    for (std::size_t k = 0; k < 2; ++k) {
+    for (std::size_t k = 0; k < per_mode; ++k) {
       const JsonObject e(modes[i + k], "modes[" + std::to_string(i + k) + "]", source_name);
       e.allow_only({"mode", "kind", "freq_hz", "zeta", "freq_hz_std", "zeta_std"});
       const std::string kind = e.string("kind");
-      const char* expected = k == 0 ? "antiresonance" : "resonance";
-      if (kind != expected) e.fail("kind", std::string("expected \"") + expected + "\" (entries alternate antiresonance, resonance), got \"" + kind + "\"");
-      const int number = e.integer_or("mode", static_cast<int>(i / 2 + 1));
-      if (number != static_cast<int>(i / 2 + 1)) e.fail("mode", "expected mode " + std::to_string(i / 2 + 1));
-      fit::ModalPair& p = k == 0 ? mode.antiresonance : mode.resonance;
+      const bool zeros = !load && k == 0;
+      const char* expected = zeros ? "antiresonance" : "resonance";
+      if (kind != expected)
+        e.fail("kind", std::string("expected \"") + expected + "\" " +
+                           (load ? "(a load-side model has resonances only)" : "(entries alternate antiresonance, resonance)") +
+                           ", got \"" + kind + "\"");
+      const int number = e.integer_or("mode", static_cast<int>(i / per_mode + 1));
+      if (number != static_cast<int>(i / per_mode + 1)) e.fail("mode", "expected mode " + std::to_string(i / per_mode + 1));
+      fit::ModalPair& p = zeros ? mode.antiresonance : mode.resonance;
       p.omega_rad_s = kTwoPi * positive(e, "freq_hz");
       p.zeta = positive(e, "zeta");
     }

@@ -36,15 +36,24 @@ std::string with_std(double value, double std_dev, double scale = 1.0) {
 
 std::string with_std(const fit::Estimate& e, double scale = 1.0) { return with_std(e.value, e.std, scale); }
 
+/// A two-column table: a name and its value per row.
+Table value_table(std::string title, std::string name_header, std::vector<std::vector<std::string>> rows) {
+  Table t;
+  t.title = std::move(title);
+  t.header = {std::move(name_header), "value"};
+  t.rows = std::move(rows);
+  return t;
+}
+
 Section model_section(const fit::FitReport& report) {
   const fit::FitResult& r = report.result;
   const fit::PlantModel& m = r.model;
   Section s;
   s.title = "Fitted model";
   s.text = fmt::format(
-      "Model {} with {} flexible mode(s), {} output ({}), rigid part {}{}{}. Fitted by Levenberg-Marquardt on the "
-      "log-relative complex error ({} weighting) from the {} start: {}.",
-      fit::to_string(report.request), m.modes.size(), fit::to_string(m.output), report.output.note.empty() ? "as asked" : report.output.note,
+      "Model {} with {} flexible mode(s) measured on the {} side, {} output ({}), rigid part {}{}{}. Fitted by "
+      "Levenberg-Marquardt on the log-relative complex error ({} weighting) from the {} start: {}.",
+      fit::to_string(report.request), m.modes.size(), fit::to_string(m.sensor), fit::to_string(m.output), report.output.note.empty() ? "as asked" : report.output.note,
       m.rigid == fit::RigidKind::kIntegrator ? "K/s" : "K/(s + a)", m.lag_pole_rad_s ? ", extra lag 1/(s + tau2)" : "",
       m.delay_s ? ", delay e^(-sT)" : "", r.weighting, r.initialization, r.message);
   Table t;
@@ -78,8 +87,12 @@ Section modes_section(const fit::FitReport& report) {
   const fit::FitResult& r = report.result;
   Section s;
   s.title = "Modes";
-  s.text = "Antiresonance (zeros) and resonance (poles) of each flexible mode, with one standard deviation from the "
-           "Jacobian of the fit.";
+  s.text = r.model.sensor == fit::SensorSide::kMotor
+               ? "Antiresonance (zeros) and resonance (poles) of each flexible mode, with one standard deviation from "
+                 "the Jacobian of the fit."
+               : "Resonance (poles) of each flexible mode of a load-side response, which has no antiresonance (each "
+                 "mode's zero is the shaft's damping, 2 zeta w s + w^2), with one standard deviation from the Jacobian "
+                 "of the fit.";
   Table t;
   t.title = "Modes";
   t.header = {"mode", "antiresonance [Hz]", "zeta", "resonance [Hz]", "zeta", "ratio r"};
@@ -94,7 +107,8 @@ Section modes_section(const fit::FitReport& report) {
       row.insert(row.end(), {num(mode.antiresonance.omega_rad_s / kTwoPi), num(mode.antiresonance.zeta),
                              num(mode.resonance.omega_rad_s / kTwoPi), num(mode.resonance.zeta)});
     }
-    row.push_back(num(mode.resonance.omega_rad_s / mode.antiresonance.omega_rad_s, 4));
+    row.push_back(r.model.sensor == fit::SensorSide::kMotor ? num(mode.resonance.omega_rad_s / mode.antiresonance.omega_rad_s, 4)
+                                                            : "-");
     t.rows.push_back(std::move(row));
   }
   if (t.rows.empty()) s.text = "The model has no flexible mode (rigid body only).";
@@ -111,18 +125,15 @@ Section physical_section(const fit::FitReport& report) {
     return s;
   }
   const fit::TwoMassParameters& q = *p.parameters;
-  s.text = "Two-mass reading of the one-mode model (C3.12): Im = 1/K, Il = Im (r^2 - 1), k = Il wz^2, b = 2 zeta_z wz Il. "
-           "Units follow the data (torque in N m and velocity in rad/s give kg m^2, N m/rad, N m s/rad).";
-  Table t;
-  t.title = "Two-mass parameters";
-  t.header = {"parameter", "value"};
-  t.rows.push_back({"motor inertia Im", with_std(q.motor_inertia)});
-  t.rows.push_back({"load inertia Il", with_std(q.load_inertia)});
-  t.rows.push_back({"shaft stiffness k", with_std(q.stiffness)});
-  t.rows.push_back({"shaft damping b", with_std(q.damping)});
-  t.rows.push_back({"resonance ratio r", with_std(q.resonance_ratio)});
-  t.rows.push_back({"damping consistency zeta_n/(r zeta_z)", num(q.damping_consistency, 4)});
-  s.tables.push_back(std::move(t));
+  s.text = "Two-mass reading of the one-mode model (C3.12): Im = 1/K (tau2/K with a lag), Il = Im (r^2 - 1), k = Il wz^2, "
+           "b = 2 zeta_z wz Il; " + p.note + ". Units follow the data (torque in N m and velocity in rad/s give kg m^2, N m/rad, N m s/rad).";
+  s.tables.push_back(value_table("Two-mass parameters", "parameter",
+                                 {{"motor inertia Im", with_std(q.motor_inertia)},
+                                  {"load inertia Il", with_std(q.load_inertia)},
+                                  {"shaft stiffness k", with_std(q.stiffness)},
+                                  {"shaft damping b", with_std(q.damping)},
+                                  {"resonance ratio r", with_std(q.resonance_ratio)},
+                                  {"damping consistency zeta_n/(r zeta_z)", num(q.damping_consistency, 4)}}));
   return s;
 }
 
@@ -168,18 +179,45 @@ Section nonlinear_section(const fit::NonlinearMechanics& n) {
   return s;
 }
 
-Section response_section(const core::FrequencyResponse& measured, const fit::PlantModel& model) {
+Section friction_section(const fit::CoulombFit& f) {
+  Section s;
+  s.title = "Coulomb friction";
+  s.text = "The two-mass model with Coulomb friction on motor and load, fitted at each point's measured amplitude "
+           "(describing functions 4M/(pi V), harmonic balance). Its linear part (viscous damping only) is the model "
+           "above and the one written: " + f.note + ".";
+  s.tables.push_back(value_table("Friction and residuals", "quantity",
+                                 {{"motor Coulomb friction Mm (input units)", with_std(f.motor_coulomb)},
+                                  {"load Coulomb friction Ml (input units)", with_std(f.load_coulomb)},
+                                  {"motor viscous damping bv", with_std(f.viscous_damping)},
+                                  {"total inertia Jm + Jl", with_std(f.total_inertia)},
+                                  {"rms |ln(P_model/P_meas)| with friction", num(f.rms_log_error, 4)},
+                                  {"rms |ln(P_model/P_meas)| of the linear fit", num(f.linear_rms_log_error, 4)}}));
+  return s;
+}
+
+Section response_section(const core::FrequencyResponse& measured, const fit::PlantModel& model,
+                         const fit::CoulombFit* friction) {
   Section s;
   s.title = "Frequency response";
-  s.text = "Measured points and the fitted model (delay included) on a dense grid over the measured range; the last "
-           "chart is the relative error of the model at each measured point.";
-  std::vector<double> f_meas, rel_error, rel_std;
-  std::vector<std::complex<double>> p_meas;
+  s.text = friction ? "Measured points, the model with Coulomb friction at each measured point (its amplitude) and its "
+                      "linear part (delay included) on a dense grid over the measured range; the last chart is the "
+                      "relative error of the model with friction at each measured point."
+                    : "Measured points and the fitted model (delay included) on a dense grid over the measured range; "
+                      "the last chart is the relative error of the model at each measured point.";
+  std::vector<double> f_meas, rel_error, rel_std, f_friction;
+  std::vector<std::complex<double>> p_meas, p_friction;
   bool any_std = false;
   for (const auto& p : measured.points) {
     f_meas.push_back(p.freq_hz);
     p_meas.push_back(p.value);
-    const std::complex<double> model_value = model.response(kTwoPi * p.freq_hz);
+    std::complex<double> model_value = model.response(kTwoPi * p.freq_hz);
+    if (friction) {
+      model_value = fit::coulomb_response_at(*friction, p);
+      if (std::isfinite(model_value.real())) {
+        f_friction.push_back(p.freq_hz);
+        p_friction.push_back(model_value);
+      }
+    }
     rel_error.push_back(std::abs(model_value / p.value - 1.0));
     rel_std.push_back(p.std_dev > 0.0 ? p.std_dev / std::abs(p.value) : std::nan(""));
     any_std = any_std || p.std_dev > 0.0;
@@ -205,10 +243,22 @@ Section response_section(const core::FrequencyResponse& measured, const fit::Pla
   };
   Chart mag = chart("Magnitude", "magnitude [dB]", Scale::Linear);
   mag.series.push_back({"measured", f_meas, magnitude_db(p_meas)});
-  mag.series.push_back({"fitted model", f_model, magnitude_db(p_model)});
+  const std::string model_name = friction ? "linear part" : "fitted model";
+  mag.series.push_back({model_name, f_model, magnitude_db(p_model)});
   Chart phase = chart("Phase", "phase [deg]", Scale::Linear);
   phase.series.push_back({"measured", f_meas, measured_phase});
-  phase.series.push_back({"fitted model", f_model, model_phase});
+  phase.series.push_back({model_name, f_model, model_phase});
+  if (!f_friction.empty()) {
+    mag.series.push_back({"with Coulomb friction", f_friction, magnitude_db(p_friction)});
+    std::vector<double> friction_phase;
+    for (std::size_t i = 0; i < p_friction.size(); ++i) {
+      // On the linear part's branch at that frequency, as the measured phase.
+      const auto j = static_cast<std::size_t>(std::lower_bound(f_model.begin(), f_model.end(), f_friction[i]) - f_model.begin());
+      const double branch = model_phase[std::min(j, model_phase.size() - 1)];
+      friction_phase.push_back(branch + std::remainder(std::arg(p_friction[i]) * 180.0 / std::numbers::pi - branch, 360.0));
+    }
+    phase.series.push_back({"with Coulomb friction", f_friction, friction_phase});
+  }
   Chart error = chart("Relative error of the model", "|P_model/P_meas - 1|", Scale::Log);
   error.series.push_back({"model error", f_meas, rel_error});
   if (any_std) error.series.push_back({"measurement std (relative)", f_meas, rel_std});
@@ -219,7 +269,8 @@ Section response_section(const core::FrequencyResponse& measured, const fit::Pla
 }  // namespace
 
 Document fit_report(const core::FrequencyResponse& measured, const fit::FitReport& report, const std::string& source,
-                    const fit::NonlinearMechanics* nonlinear) {
+                    const fit::NonlinearMechanics* nonlinear, const fit::CoulombFit* friction) {
+  if (friction && !friction->fitted) friction = nullptr;
   if (measured.points.empty()) throw core::InputError(core::at_field("points"), "the frequency response has no points");
   Document doc;
   doc.title = "servotwin fit: plant model";
@@ -231,7 +282,8 @@ Document fit_report(const core::FrequencyResponse& measured, const fit::FitRepor
   doc.sections.push_back(physical_section(report));
   doc.sections.push_back(selection_section(report));
   if (nonlinear) doc.sections.push_back(nonlinear_section(*nonlinear));
-  doc.sections.push_back(response_section(measured, report.result.model));
+  if (friction) doc.sections.push_back(friction_section(*friction));
+  doc.sections.push_back(response_section(measured, report.result.model, friction));
   return doc;
 }
 

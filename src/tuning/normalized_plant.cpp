@@ -68,6 +68,7 @@ void check_rigid_and_gain(const fit::PlantModel& m) {
 }
 
 void check_modes(const fit::PlantModel& m) {
+  fit::require_motor_side(m, "controller tuning (C7)", "sensor");
   if (m.modes.empty())
     throw InputError(core::at_field("modes"), "not a flexible plant: use a rigid-body tuning (the model has no mode)");
   for (std::size_t i = 0; i < m.modes.size(); ++i) {

@@ -16,6 +16,7 @@ machine::MassChain two_mass_chain(const fit::PlantModel& m) {
     throw core::InputError(core::at_field("model"), fmt::format("a two-mass plant needs one flexible mode; the model "
                                                                 "has {}",
                                                                 m.modes.size()));
+  fit::require_motor_side(m, "the two-mass realization", "model");
   const fit::Mode& mode = m.modes.front();
   const double wz = mode.antiresonance.omega_rad_s, wn = mode.resonance.omega_rad_s;
   if (!(m.gain > 0.0) || !(wn > wz))
@@ -57,7 +58,9 @@ machine::PlantConfig realize_plant_model(const fit::PlantModel& model, Realizati
     config.description = "two-mass realization of a fitted plant model";
   } else {
     config.model = machine::TransferFunctionModel{model.transfer_function()};
-    config.description = "transfer-function realization of a fitted plant model";
+    config.description = model.sensor == fit::SensorSide::kLoad
+                             ? "transfer-function realization of a load-side fitted plant model (its output is the load's)"
+                             : "transfer-function realization of a fitted plant model";
   }
   machine::validate(config);
   return config;

@@ -3,6 +3,7 @@
 // preset's construction, machine/flexible_presets.hpp), the trace is written on request, and bad
 // requests are named. The 0.5 % / 20 % / 30 s checks live in tests/vcnc/test_frf_experiment.cpp.
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 
 #include "cli_support.hpp"
@@ -102,6 +103,37 @@ TEST_F(Cli, FitWithFrictionWritesTheLinearPart) {
   const std::string json = slurp(path("model.json"));
   EXPECT_NE(json.find("\"friction\""), std::string::npos);
   EXPECT_NE(json.find("\"load_coulomb\""), std::string::npos);
+}
+
+// A load encoder's response (issue 25 §1): the motor-side fit says how to fit it, --sensor load
+// fits the resonance alone (with --friction too) and writes a load-side model, which shaper
+// selection takes and tuning refuses with the reason.
+TEST_F(Cli, FitOfALoadEncodersResponse) {
+  write("bench.json", R"({"format": "servotwin.plant/1", "type": "two-mass",
+    "motor_inertia": 0.0048146, "load_inertia": 0.0050854, "stiffness": 563.95, "damping": 0.06774,
+    "motor_viscous": 2e-4, "load_viscous": 1e-4, "coulomb": 0.56, "motor_coulomb": 0.56, "stick_band": 0.005,
+    "backlash": 0, "noise_std": 0.06, "quantization": 0, "current_lag": 0.0002, "ts": 0.000125,
+    "output": "load_velocity"})");
+  ASSERT_EQ(run("-q frf measure --plant bench.json --range-hz 1:500 -o frf.csv").status, 0);
+  const Result motor = run("fit frf.csv --lag");
+  EXPECT_EQ(motor.status, 3);
+  EXPECT_NE(motor.err.find("load sensor"), std::string::npos) << motor.err;
+  const Result load = run("fit frf.csv --sensor load --lag -o load.json");
+  ASSERT_EQ(load.status, 0) << load.err;
+  EXPECT_NE(load.out.find("load-side mode"), std::string::npos) << load.out;
+  const io::LoadedPlantModel back = io::load_plant_model(path("load.json").string());
+  EXPECT_EQ(back.model.sensor, fit::SensorSide::kLoad);
+  ASSERT_EQ(back.model.modes.size(), 1u);
+  EXPECT_NEAR(back.model.modes.front().resonance.omega_rad_s / (2.0 * std::numbers::pi), 76.0, 0.4);  // C3.12: 76.0 Hz
+  EXPECT_EQ(run("shaper select load.json").status, 0);
+  const Result tune = run("tune load.json --ts 0.000125 -o pi.json");
+  EXPECT_EQ(tune.status, 3);
+  EXPECT_NE(tune.err.find("load-side"), std::string::npos) << tune.err;
+  EXPECT_FALSE(std::filesystem::exists(path("pi.json")));
+  EXPECT_EQ(run("fit frf.csv --sensor load --amplitude-series frf.csv").status, 3);
+  const Result friction = run("fit frf.csv --sensor load --lag --friction");
+  ASSERT_EQ(friction.status, 0) << friction.err;
+  EXPECT_NE(friction.out.find("total inertia J = "), std::string::npos) << friction.out;
 }
 
 }  // namespace

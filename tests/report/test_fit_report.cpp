@@ -10,6 +10,7 @@
 
 #include "report_test_support.hpp"
 #include "servotwin/core/error.hpp"
+#include "servotwin/fit/friction_fit.hpp"
 #include "servotwin/report/fit_report.hpp"
 
 namespace servotwin::report {
@@ -62,6 +63,36 @@ TEST(FitReport, ListsThePointsLeftOutAndWhy) {
   const std::string html = testing::render(fit_report(measured, fitted, "e10.csv"));
   EXPECT_NE(html.find("Points left out (marked invalid by the measurement, or outliers of the first fit)"), std::string::npos);
   EXPECT_NE(html.find("THD 0.39 above 0.07 at amplitude 2.4"), std::string::npos);
+}
+
+TEST(FitReport, WithFrictionDrawsTheModelWithFrictionAndItsLinearPart) {
+  // A swept-sine response (each point with its amplitude) of the motor bench's two-mass chain
+  // without friction (the chain's own equations, fit::coulomb_two_mass_response at zero levels):
+  // the friction fit finds none, so the model with friction at each point equals the data to the
+  // fit's accuracy, and the report draws it beside the linear part and says what was fitted.
+  core::FrequencyResponse measured;
+  measured.quality_kind = core::QualityKind::kThd;
+  for (double f : core::log_space(1.0, 300.0, 40)) {
+    core::FrequencyPoint p;
+    p.freq_hz = f;
+    p.value = fit::coulomb_two_mass_response(kTwoPi * f, 1.0, 0.0048146, 0.0050854, 563.95, 0.06774, 3e-4, 0.0, 0.0, {});
+    p.amplitude = 2.0;
+    measured.points.push_back(p);
+  }
+  const fit::FitReport linear = fit::fit_plant(measured, {fit::ModelRequest::Kind::kTwoMass, 1});
+  const fit::CoulombFit friction = fit::fit_coulomb_friction(measured, linear, {});
+  ASSERT_TRUE(friction.fitted) << friction.note;
+  const fit::FitReport written = fit::with_friction_model(linear, friction);
+  const Document doc = fit_report(measured, written, "e10.csv", nullptr, &friction);
+  const std::string html = testing::render(doc);
+  EXPECT_NE(html.find("Coulomb friction"), std::string::npos);
+  EXPECT_NE(html.find("load Coulomb friction Ml"), std::string::npos);
+  const Section& response = doc.sections.back();
+  ASSERT_EQ(response.charts[0].series.size(), 3u);
+  EXPECT_EQ(response.charts[0].series[1].label, "linear part");
+  EXPECT_EQ(response.charts[0].series[2].label, "with Coulomb friction");
+  EXPECT_EQ(response.charts[0].series[2].x.size(), measured.points.size());
+  for (double e : response.charts[2].series[0].y) EXPECT_LT(e, 1e-6);
 }
 
 TEST(FitReport, AnEmptyResponseIsAnInputError) {

@@ -49,6 +49,9 @@ struct FitOptions {
   RigidKind rigid = RigidKind::kRealPole;
   bool lag = false;             ///< fit the extra lag pole 1/(s + τ2)
   bool delay = false;           ///< fit a pure delay e^{-sT}
+  /// Where the response was measured: kLoad fits resonances alone, each with the shaft's damping
+  /// zero (plant_model.hpp), for a load encoder's response, which has no antiresonance.
+  SensorSide sensor = SensorSide::kMotor;
   int max_iterations = 200;     ///< Levenberg–Marquardt iteration limit per start
   std::size_t max_modes = 4;    ///< largest n tried by automatic order selection
   /// fit_plant: after the fit, points whose weighted residual exceeds 4.5 robust standard
@@ -174,6 +177,9 @@ struct FitReport {
   /// the outlier rule (FitOptions::reject_outliers), left out of the fit: "1 Hz: THD 0.39 above
   /// 0.07 ...", "3.2 Hz: outlier: residual 7.1 robust sigma ...", in frequency order.
   std::vector<std::string> left_out;
+  /// The frequencies of `left_out`, in the same order (for fits that build on this one, such as
+  /// the fit with Coulomb friction, which must use the same points).
+  std::vector<double> left_out_hz;
 };
 
 /// Automatic order selection (kAuto) tries n = 0 .. min(max_modes, resonances found by peak

@@ -8,7 +8,8 @@
 /// and at the antiresonance, where the motor barely moves and the load swings, the load's friction
 /// adds (2/π)·M_l/T of damping to ζz (T the excitation amplitude there). Both depend on the
 /// velocity amplitudes, which the measurement knows: every point carries its excitation amplitude
-/// (FrequencyPoint::amplitude), so the motor's velocity amplitude is |P|·T.
+/// (FrequencyPoint::amplitude), so the motor's velocity amplitude is |P|·T (ω|P|·T for a position
+/// output).
 ///
 /// The model (dissertation C3.12's two-mass with C5.10's describing functions, harmonic balance
 /// at each point): motor inertia Jm with viscous damping bv and Coulomb level Mm, shaft stiffness k
@@ -20,10 +21,22 @@
 ///
 ///   P = L(s) / (Jm s + bv + 4Mm/(π|Vm|) + Z (1 − G)),
 ///
-/// explicit in the parameters. Levenberg–Marquardt fits (ln Jm, ln Jl, ln k, ln bs, bv, Mm, Ml, and
+/// explicit in the parameters. Seen from a load encoder (a load-side linear fit,
+/// SensorSide::kLoad) the balance is explicit too: the load's describing function cl = 4Ml/(π|Vl|)
+/// comes from the measured |Vl|, the load's balance gives Vm/Vl = H = 1 + (Jl s + cl)/Z and with it
+/// |Vm| and the motor's describing function, and P = L/((Jm s + bv + 4Mm/(π|Vm|))H + Jl s + cl).
+/// A load-side response's linear part does not tell Jm from Jl (it depends on J = Jm + Jl,
+/// k·J/(Jm Jl) and bs·J/(Jm Jl) only); the friction does, since the two describing functions act
+/// on different velocities. The share Jm/J is fitted from 1/2 and, when the friction is too small
+/// to tell it (a singular Jacobian), held there and said so in the note.
+/// Levenberg–Marquardt fits (ln Jm, ln Jl, ln k, ln bs, bv, Mm, Ml, and
 /// the lag pole and delay when the linear fit has them: friction bends its phase, and with it the
-/// lag) to the valid points' complex log errors, from the linear fit's physical parameters: one
-/// start reads its rigid pole as viscous damping, two as Coulomb friction.
+/// lag) to the complex log errors of the points the linear fit used (its left-out points stay out),
+/// weighted as the linear fit weights them (fit.hpp), from the linear fit's physical parameters:
+/// one start reads its rigid pole as viscous damping, two as Coulomb friction; the converged start
+/// of least cost wins. Standard deviations follow the linear fit's rule
+/// (FitResult::uncertainty_scale); with `--rigid integrator` bv is held at 0 and is not a
+/// parameter of the covariance.
 
 #include <Eigen/Dense>
 #include <complex>
@@ -40,35 +53,50 @@ namespace servotwin::fit {
 struct CoulombFit {
   bool fitted = false;
   std::string note;                    ///< how it was fitted, or why not
-  /// The linear part (viscous damping only): what tuning and simulation should use. Same output,
-  /// lag and delay as the linear fit; an integrator when bv = 0.
+  /// The linear part (viscous damping only): what tuning and simulation should use. The linear
+  /// fit's output kind, the lag and delay refitted with the friction; an integrator when bv = 0.
   PlantModel model;
+  Estimate gain;                       ///< the linear part's K = p/Jm (1/Jm without a lag)
   Estimate motor_coulomb, load_coulomb;  ///< Mm, Ml in the input's units (torque, force, current)
   Estimate motor_inertia, load_inertia, stiffness, shaft_damping, viscous_damping;
+  Estimate total_inertia;              ///< Jm + Jl (its std from the fit on the load side only)
+  Estimate motor_share;                ///< Jm/(Jm + Jl) (its std from the fit on the load side only)
   Estimate rigid_pole_rad_s;           ///< bv's pole of the linear part (0 for an integrator)
   Estimate resonance_ratio;            ///< r = ωn/ωz of the linear part
   Estimate lag_pole_rad_s, delay_s;    ///< refitted with the friction (NaN when the linear fit has none)
-  ModeUncertainty mode;                ///< antiresonance and resonance of the linear part
-  /// θ = (ln Jm, ln Jl, ln k, ln bs, bv, Mm, Ml[, ln p][, T]) (scaled) at the solution and its covariance (scaled by the
-  /// residual variance, as the linear fit's).
+  ModeUncertainty mode;                ///< antiresonance (NaN on the load side) and resonance of the linear part
+  /// θ = (ln Jm, ln Jl, ln k, ln bs, bv, Mm, Ml[, ln p][, T]) (scaled) at the solution and its
+  /// covariance (the linear fit's rule; the row and column of a bv held at 0 are zero).
   Eigen::VectorXd theta;
   Eigen::MatrixXd covariance;
-  double rms_log_error = 0.0;          ///< with the friction terms
+  std::string weighting;               ///< "std_dev" or "log-relative", as the linear fit's
+  double cost = 0.0;                   ///< ½ Σ |e_l|² (weighted) at the solution
+  double sigma2 = 0.0;                 ///< residual variance of the covariance (1 with std_dev)
+  double uncertainty_scale = 1.0;      ///< as FitResult::uncertainty_scale
+  std::string uncertainty_note;
+  double rms_log_error = 0.0;          ///< with the friction terms, unweighted
   double linear_rms_log_error = 0.0;   ///< of the linear fit on the same points
   std::size_t points = 0;
   int iterations = 0;
   std::string message;                 ///< LM stopping reason
 };
 
-/// Fits the two-mass model with Coulomb friction to `response` (its valid points), starting from
-/// `linear` (a two-mass fit of the same response with physical parameters). Returns fitted = false
-/// with the reason when the linear fit has no two-mass parameters, the points carry no excitation
+/// Fits the two-mass model with Coulomb friction to `response` (the points `linear` used: valid and
+/// not in linear.left_out_hz), starting from `linear` (a two-mass fit of the same response with
+/// physical parameters, or a one-mode load-side fit; the side is linear's). Returns fitted = false
+/// with the reason when the linear fit has no two-mass reading, the points carry no excitation
 /// amplitude, or LM does not converge. `options.rigid == kIntegrator` fixes bv = 0.
 CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const FitReport& linear, const FitOptions& options);
 
 /// `linear` with its result replaced by the friction fit's linear part (model, estimates, physical
-/// parameters, residual), the report to write and tune from; `linear` unchanged when !f.fitted.
+/// parameters, residual, weighting and uncertainty rule), the report to write and tune from;
+/// `linear` unchanged when !f.fitted.
 FitReport with_friction_model(FitReport linear, const CoulombFit& f);
+
+/// The fitted model with friction at a measured point (its excitation amplitude and measured
+/// magnitude give the velocity amplitudes), e.g. to draw it over the measurement. NaN when the
+/// point carries no amplitude or !f.fitted.
+std::complex<double> coulomb_response_at(const CoulombFit& f, const core::FrequencyPoint& point);
 
 /// The model response P(jω) of a point of excitation amplitude `amplitude` whose measured motor
 /// velocity amplitude is `motor_velocity_amplitude` (exposed for tests). Parameters as in CoulombFit
@@ -76,5 +104,11 @@ FitReport with_friction_model(FitReport linear, const CoulombFit& f);
 std::complex<double> coulomb_two_mass_response(double omega_rad_s, double motor_velocity_amplitude, double jm, double jl,
                                                double k, double bs, double bv, double mm, double ml,
                                                const PlantModel& linear_model);
+
+/// The same chain seen from the load encoder: the load's velocity over the torque at a point whose
+/// measured load velocity amplitude is `load_velocity_amplitude` (exposed for tests).
+std::complex<double> coulomb_two_mass_load_response(double omega_rad_s, double load_velocity_amplitude, double jm, double jl,
+                                                    double k, double bs, double bv, double mm, double ml,
+                                                    const PlantModel& linear_model);
 
 }  // namespace servotwin::fit

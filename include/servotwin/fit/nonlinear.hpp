@@ -87,7 +87,8 @@ BacklashEstimate estimate_backlash(const FitReport& linear, std::span<const core
 
 /// Both, for `servotwin fit --amplitude-series`: `experiments` holds every measurement (the one
 /// `linear` was fitted to included). Every point is used, including those the measurement marked
-/// invalid (FrequencyPoint::valid): their distortion is what the series measures.
+/// invalid (FrequencyPoint::valid): their distortion is what the series measures. core::InputError
+/// (field `--amplitude-series`) when `linear` is a load-side model (require_motor_side).
 NonlinearMechanics analyze_nonlinear_mechanics(const FitReport& linear, std::span<const core::FrequencyResponse> experiments,
                                                const FitOptions& options);
 

@@ -8,7 +8,12 @@
 /// optional lag L = 1/(s + τ2) (test-bed form, catalog A6; it lumps sampling, communication and
 /// actuator lag), an optional pure delay, and O = 1 for a velocity output or 1/s for a position
 /// output. Each mode is an antiresonance (complex zero pair) with its resonance (complex pole
-/// pair). The model is held in modal parameters; the transfer function is derived from them.
+/// pair) when the sensor is on the motor (collocated). With the sensor on the load of a mass chain
+/// (non-collocated, e.g. a load encoder) a mode has no antiresonance: its factor is
+/// (2ζp ωp s + ωp²)/(s² + 2ζp ωp s + ωp²), the shaft's damping zero b s + k of C3.12's load
+/// velocity over the torque, (b s + k)/(s (Jm Jl s² + (Jm + Jl)(b s + k))), written with
+/// ωp² = k (Jm + Jl)/(Jm Jl) and 2ζp ωp = b (Jm + Jl)/(Jm Jl); K is then 1/(Jm + Jl) (times the
+/// lag's τ2). The model is held in modal parameters; the transfer function is derived from them.
 /// Frequencies are in rad/s (design.md "Units").
 
 #include <complex>
@@ -26,10 +31,16 @@ enum class OutputKind { kVelocity, kPosition };
 /// The rigid-body part: a real pole K/(s+a) or an integrator K/s.
 enum class RigidKind { kRealPole, kIntegrator };
 
+/// Where the measured output is taken: on the motor (collocated: every mode has its
+/// antiresonance) or on the load (non-collocated: resonances alone).
+enum class SensorSide { kMotor, kLoad };
+
 /// "velocity" / "position".
 [[nodiscard]] std::string to_string(OutputKind output);
 /// "pole" / "integrator".
 [[nodiscard]] std::string to_string(RigidKind rigid);
+/// "motor" / "load".
+[[nodiscard]] std::string to_string(SensorSide sensor);
 
 /// Natural frequency and damping of a complex pair s² + 2ζωs + ω².
 struct ModalPair {
@@ -38,7 +49,8 @@ struct ModalPair {
 };
 
 /// One flexible mode: the antiresonance (zeros) and resonance (poles). For a collocated
-/// (motor-side) measurement the antiresonance lies below the resonance.
+/// (motor-side) measurement the antiresonance lies below the resonance; for a load-side one the
+/// antiresonance is unused and zero.
 struct Mode {
   ModalPair antiresonance;
   ModalPair resonance;
@@ -48,6 +60,7 @@ struct Mode {
 struct PlantModel {
   OutputKind output = OutputKind::kVelocity;
   RigidKind rigid = RigidKind::kRealPole;
+  SensorSide sensor = SensorSide::kMotor;
   double gain = 1.0;                       ///< K (high-frequency asymptote K/s of a velocity model without lag)
   double rigid_pole_rad_s = 0.0;           ///< a for kRealPole; ignored for kIntegrator
   std::vector<Mode> modes;                 ///< ordered by increasing resonance frequency
@@ -58,7 +71,7 @@ struct PlantModel {
   [[nodiscard]] std::complex<double> response(double omega_rad_s) const noexcept;
   /// The rational part num/den (the delay, if any, is not included). Denominator monic.
   [[nodiscard]] core::TransferFunction transfer_function() const;
-  /// Number of free parameters of this structure (K, a, 4 per mode, τ2, T).
+  /// Number of free parameters of this structure (K, a, 4 per mode (2 on the load side), τ2, T).
   [[nodiscard]] std::size_t parameter_count() const noexcept;
 };
 
@@ -74,6 +87,12 @@ struct PlantModel {
                                                             const std::string& field = "plant");
 
 /// Parameter count of a structure without building the model.
-[[nodiscard]] std::size_t parameter_count(std::size_t modes, RigidKind rigid, bool lag, bool delay) noexcept;
+[[nodiscard]] std::size_t parameter_count(std::size_t modes, RigidKind rigid, bool lag, bool delay,
+                                          SensorSide sensor = SensorSide::kMotor) noexcept;
+
+/// core::InputError (field `field`) naming `what` when `model` is a load-side model: the
+/// controller tuning, the two-mass realization and the friction analyses need the antiresonance
+/// that only a motor-side measurement shows.
+void require_motor_side(const PlantModel& model, const std::string& what, const std::string& field = "plant");
 
 }  // namespace servotwin::fit

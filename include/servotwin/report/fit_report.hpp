@@ -8,6 +8,7 @@
 
 #include "servotwin/core/frequency_response.hpp"
 #include "servotwin/fit/fit.hpp"
+#include "servotwin/fit/friction_fit.hpp"
 #include "servotwin/fit/nonlinear.hpp"
 #include "servotwin/report/document.hpp"
 
@@ -22,12 +23,16 @@ namespace servotwin::report {
 ///  - "Model order": the criterion and every candidate's cost and score;
 ///  - "Nonlinear mechanics" (when `nonlinear` is given): Coulomb friction and backlash with the
 ///    antiresonance per amplitude;
+///  - "Coulomb friction" (when `friction` is given and fitted; `report` is then the one written,
+///    fit::with_friction_model): Mm, Ml, viscous damping and both residuals; the response charts
+///    then draw the model with friction at each measured point besides its linear part, and the
+///    error chart is that of the model with friction;
 ///  - "Frequency response": Bode magnitude and phase of the measured points (as measured) and of the
 ///    fitted model on a dense logarithmic grid over the measured range (delay included), and the
 ///    relative error |P_model/P_meas - 1| per point with the point's relative standard deviation
 ///    when the data carry one.
 /// `source` names the measured file in the subtitle. core::InputError when the response is empty.
 Document fit_report(const core::FrequencyResponse& measured, const fit::FitReport& report, const std::string& source,
-                    const fit::NonlinearMechanics* nonlinear = nullptr);
+                    const fit::NonlinearMechanics* nonlinear = nullptr, const fit::CoulombFit* friction = nullptr);
 
 }  // namespace servotwin::report
