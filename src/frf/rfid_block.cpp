@@ -66,6 +66,10 @@ RfidParameters validated(RfidParameters p) {
   if (!std::isfinite(p.thd_hysteresis) || p.thd_hysteresis < 0.0 || p.thd_hysteresis >= p.thd_threshold)
     reject("thd_hysteresis", "0 <= h < thd_threshold", p.thd_hysteresis);
   require_finite_positive(p.amplitude_rate, "amplitude_rate");
+  if (!std::isfinite(p.max_settling_periods) || p.max_settling_periods < 0.0)
+    reject("max_settling_periods", "0 (no limit by periods) or a finite value > 0", p.max_settling_periods);
+  if (!std::isfinite(p.amplitude_growth_per_second) || p.amplitude_growth_per_second < 0.0)
+    reject("amplitude_growth_per_second", "a finite value >= 0", p.amplitude_growth_per_second);
   if (!std::isfinite(p.fade_in_periods) || p.fade_in_periods < 0.0 || p.fade_in_periods > 100.0)
     reject("fade_in_periods", "a value in [0, 100]", p.fade_in_periods);
   const bool min_inf = std::isinf(p.output_min) && p.output_min < 0.0;
@@ -107,6 +111,8 @@ AmplitudeLaw amplitude_law_of(const RfidParameters& p) {
   law.minimum = kMinimumAmplitudeFraction * p.initial_amplitude;
   law.rate = p.amplitude_rate;
   law.proportional = p.proportional_growth;
+  law.growth_per_second = p.amplitude_growth_per_second;
+  law.ts = p.ts;
   law.thd_threshold = p.thd_threshold;
   law.thd_hysteresis = p.thd_hysteresis;
   // With a known noise level the SNR drives the relay too (issue 25 §1).
@@ -136,6 +142,13 @@ RfidBlock::RfidBlock(RfidParameters parameters)
 
 long RfidBlock::period_samples(double omega) const noexcept {
   return std::max(1L, std::lround(kTwoPi / (omega * p_.ts)));
+}
+
+long RfidBlock::max_settle_limit() const noexcept {
+  if (!(p_.max_settling_periods > 0.0)) return max_settle_samples_;
+  const auto by_periods = std::max(std::lround(p_.max_settling_periods * static_cast<double>(period_samples(omega_))),
+                                   std::lround(kMinimumPeriodLimit_s / p_.ts));
+  return std::min(max_settle_samples_, std::max(by_periods, settle_samples_ + 1));
 }
 
 void RfidBlock::start_run() noexcept {
@@ -287,7 +300,7 @@ void RfidBlock::advance_settle(std::complex<double> running, double thd) noexcep
   const bool thd_accepted = !adapter_.relay() || adapter_.blocked();
   const bool faded_in = fade_done_ >= fade_length_;
   if (settle_elapsed_ >= settle_samples_ && period_converged_ && thd_accepted && faded_in) latch(running, thd, true);
-  else if (settle_total_ >= max_settle_samples_) latch(running, thd, false);
+  else if (settle_total_ >= max_settle_limit()) latch(running, thd, false);
 }
 
 void RfidBlock::latch(std::complex<double> running, double thd, bool settled) noexcept {

@@ -78,6 +78,15 @@ double time_limit(const FrfExperimentSettings& s) {
   return s.max_time_s > 0.0 ? s.max_time_s : std::max(120.0, 200.0 / s.f_begin_hz + 4.0 * sweep_time(s));
 }
 
+/// The amplitude's least growth per second while the SNR says the motor hardly moves
+/// (AmplitudeLaw::growth_per_second): tripling each second, so a motor held by Coulomb friction
+/// three times the start amplitude moves within about a second at 1 Hz (doubling: 1.5 s more per
+/// friction-bound point; the 3x bench took 30.0 s instead of 28.8).
+constexpr double kGrowthPerSecond = 2.0;
+/// A point that has not settled in this many of its periods latches (RfidParameters::
+/// max_settling_periods): a frictionless point settles in about three.
+constexpr double kMaxSettlingPeriods = 5.0;
+
 frf::RfidParameters experiment_parameters(const machine::FlexiblePlant& plant, const FrfExperimentSettings& settings) {
   const double ts = plant.ts();
   check_settings(settings, ts);
@@ -106,10 +115,12 @@ frf::RfidParameters experiment_parameters(const machine::FlexiblePlant& plant, c
   // sweep's first and last frequencies.
   p.settling_time_s = 20.0 * ts;
   p.max_settling_time_s = std::max(2.0, 8.0 / settings.f_begin_hz);
+  p.max_settling_periods = kMaxSettlingPeriods;
   p.observer = settings.observer;
   p.thd_threshold = settings.thd_threshold;
   p.proportional_growth = true;  // antiresonances need many times A(t0)
   p.amplitude_rate = 0.1;
+  p.amplitude_growth_per_second = kGrowthPerSecond;
   p.fade_in_periods = 1.0;
   p.thd_hysteresis = 0.4 * settings.thd_threshold;
   p.noise_level = floor;

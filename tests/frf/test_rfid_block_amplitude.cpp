@@ -48,6 +48,29 @@ TEST(AmplitudeAdapter, ProportionalGrowthMultipliesByOnePlusRcPerPeriod) {
   EXPECT_NEAR(a.amplitude(), 2.0 * std::pow(1.25, 3.0), 1e-9);
 }
 
+TEST(AmplitudeAdapter, AStuckMotorsAmplitudeGrowsPerSecondNotPerPeriod) {
+  // growth_per_second = 1 while the SNR relay is on: at 1 Hz (1000 samples of 1 ms per period) the
+  // amplitude doubles per second, (1 + 1)^t, where rc = 0.25 per period alone gives 1.25^t
+  // (closed forms). With the THD relay alone it stays at (1 + rc) per period.
+  AmplitudeLaw l = law();
+  l.maximum = 1000.0;
+  l.proportional = true;
+  l.snr_minimum = 3.0;
+  l.growth_per_second = 1.0;
+  l.ts = 1e-3;
+  const double omega_ts = 2.0 * std::numbers::pi * 1e-3;  // 1 Hz
+  AmplitudeAdapter stuck(l);
+  for (int k = 0; k < 3000; ++k) stuck.update(0.01, 0.0, omega_ts, 0.5);  // SNR 0.5, 3 s
+  EXPECT_NEAR(stuck.amplitude(), 2.0 * 8.0, 1e-9);
+  AmplitudeAdapter distorted(l);
+  for (int k = 0; k < 3000; ++k) distorted.update(0.5, 0.0, omega_ts, 100.0);  // THD 0.5, clean SNR
+  EXPECT_NEAR(distorted.amplitude(), 2.0 * std::pow(1.25, 3.0), 1e-9);
+  // At 100 Hz rc per period is the faster: 1.25^(100 t), not 2^t.
+  AmplitudeAdapter fast(l);
+  for (int k = 0; k < 50; ++k) fast.update(0.01, 0.0, 100.0 * omega_ts, 0.5);  // 5 periods
+  EXPECT_NEAR(fast.amplitude(), 2.0 * std::pow(1.25, 5.0), 1e-9);
+}
+
 TEST(AmplitudeAdapter, RelayHysteresis) {
   // Relay on above THD* + h = 0.12, off below THD* - h = 0.08, holds in between.
   AmplitudeAdapter a(law());

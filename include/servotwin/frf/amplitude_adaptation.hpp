@@ -29,6 +29,13 @@ struct AmplitudeLaw {
   /// amplitude an antiresonance needs is many times A(t0)); true: rc A(t) per period, i.e. the
   /// amplitude grows by the factor (1 + rc) per period (the same time to double from any level).
   bool proportional = false;
+  /// With `proportional`, the least growth per second while the SNR relay is on: the amplitude
+  /// grows by at least the factor (1 + growth_per_second) per second of excitation (0: by (1 + rc)
+  /// per period only). At low frequencies a period is long and rc = 0.1 per period takes 18 s at
+  /// 1 Hz to raise the amplitude 5.5 times, what a motor held by Coulomb friction above the
+  /// excitation's level needs before it moves at all (issue 25 §1's 30 s).
+  double growth_per_second = 0.0;
+  double ts = 0.0;  ///< sample period [s], for growth_per_second
 };
 
 /// What the arbitration decided in the last update.

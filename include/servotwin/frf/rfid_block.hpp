@@ -55,6 +55,11 @@ struct RfidParameters {
   double sweep_rate = 0.0;           ///< linear: rad/s per sample; logarithmic: sc [1/s]
   double settling_time_s = 0.0;      ///< minimum wait in measurement mode after omega or A last changed
   double max_settling_time_s = 0.0;  ///< give up waiting and latch (flagged not settled); 0 = 5 x settling_time_s
+  /// Give up after this many periods of the point's frequency too, but not before 2 s, when that
+  /// is shorter (0: no such limit): at the lowest frequencies a point that has not settled in a
+  /// few periods is friction- or noise-bound, and the time limit alone costs seconds per such point
+  /// (issue 25 §1); above a few hertz lightly damped modes need more periods than that.
+  double max_settling_periods = 0.0;
   double settle_tolerance = 0.005;   ///< settled when |P(now) - P(half a period ago)| <= tol/2 |P(now)| + noise_level/(4 A)
   std::vector<double> measurement_frequencies;  ///< strictly increasing, inside [omega_begin, omega_end]
   ObserverDesign observer;           ///< estimator bandwidth (Kalman V or Butterworth alpha0)
@@ -62,6 +67,7 @@ struct RfidParameters {
   double thd_hysteresis = 0.02;      ///< h, 0 <= h < THD*
   double amplitude_rate = 0.2;       ///< rc: relative amplitude increment per period
   bool proportional_growth = false;  ///< AmplitudeLaw::proportional: rc A(t) instead of rc A(t0) per period
+  double amplitude_growth_per_second = 0.0;  ///< AmplitudeLaw::growth_per_second (with proportional growth)
   double output_min = -std::numeric_limits<double>::infinity();  ///< allowed pv range (abort outside)
   double output_max = std::numeric_limits<double>::infinity();
   double range_margin = 0.8;         ///< reduce A when the predicted output peak uses this fraction of the range
@@ -130,6 +136,8 @@ class RfidBlock {
   [[nodiscard]] core::FrequencyResponse frequency_response() const;
   /// Fewest A1/noise a valid point has: at 3 the noise moves the phase by up to 19°.
   static constexpr double kMinimumSnr = 3.0;
+  /// The least settling limit that max_settling_periods can set [s].
+  static constexpr double kMinimumPeriodLimit_s = 2.0;
   /// Seconds since the start edge (frozen when the run ends).
   [[nodiscard]] double elapsed_s() const noexcept { return static_cast<double>(run_samples_) * p_.ts; }
   [[nodiscard]] const RfidParameters& parameters() const noexcept { return p_; }
@@ -151,6 +159,9 @@ class RfidBlock {
   double limit_usage(double pv, double cv) const noexcept;
   double idle_command(double cv) const noexcept;
   [[nodiscard]] long period_samples(double omega) const noexcept;
+  /// The settling limit at the current frequency: max_settling_time_s, or max_settling_periods
+  /// periods when that is shorter.
+  [[nodiscard]] long max_settle_limit() const noexcept;
   double fade_in_factor() noexcept;
 
   RfidParameters p_;
