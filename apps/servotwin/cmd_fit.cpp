@@ -167,6 +167,8 @@ int run(const FitArgs& a, const GlobalOptions& global) {
   } catch (const core::InputError& e) {
     // Point-level problems name "points[i]..."; say which file they are in.
     if (e.where().field.rfind("points", 0) == 0) throw core::InputError({a.frf, 0, 0, e.where().field}, e.reason());
+    if (a.sensor == "motor" && e.reason().find("load-side response") != std::string::npos)
+      throw core::InputError(e.where(), e.reason() + " (--sensor load)");
     throw;
   }
   print_summary(a.frf, fitted);

@@ -71,6 +71,11 @@ TunePlant load_tune_plant(const std::string& name_or_path) {
     TunePlant p;
     p.model = io::load_plant_model(name_or_path).model;
     p.fitted = true;
+    try {
+      fit::require_motor_side(p.model, "controller tuning (C7)", "model.sensor");
+    } catch (const core::InputError& e) {
+      throw core::InputError({name_or_path, 0, 0, e.where().field}, e.reason());
+    }
     return p;
   }
   return from_description(io::load_plant(name_or_path), name_or_path);

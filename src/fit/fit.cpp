@@ -109,7 +109,6 @@ std::vector<std::size_t> outliers(const core::FrequencyResponse& response, const
 
 // ---- parameterization -------------------------------------------------------------------------
 
-/// Position of each parameter in θ.
 /// Position of each parameter in θ. A motor-side mode is (ln ωz, ln ζz, ln ωp, ln ζp), a
 /// load-side one (ln ωp, ln ζp).
 struct Layout {
@@ -644,7 +643,7 @@ FitResult fit_model(const core::FrequencyResponse& response, std::size_t modes, 
     f.parameters = static_cast<std::size_t>(l.size());
     f.message = "no starting point: " + failures.substr(0, failures.size() - 2);
     f.physical.note = modes == 1 && !load ? "not a two-mass system: no resonance/antiresonance pair found in the data "
-                                            "(a load encoder's response has no antiresonance: fit it with the load sensor)"
+                                            "(a load encoder's response has no antiresonance: fit it as a load-side response)"
                                           : "";
     return f;
   }

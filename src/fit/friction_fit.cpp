@@ -406,21 +406,24 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   out.weighting = known_std ? "std_dev" : "log-relative";
   out.rms_log_error = unweighted_rms(best.residual, points);
   out.linear_rms_log_error = linear.result.rms_log_error;
-  const double dof = 2.0 * static_cast<double>(m) - static_cast<double>(free_parameters);
-  out.sigma2 = known_std ? 1.0 : best.residual.squaredNorm() / dof;
-  const detail::MisfitScale misfit = detail::misfit_scale(best.residual, dof, known_std);
-  out.uncertainty_scale = misfit.factor;
-  out.uncertainty_note = misfit.note;
   Eigen::MatrixXd covariance = free_covariance(best, known_std, fixed);
   std::string held;
-  if (load && !covariance.allFinite()) {
-    // Friction too small to tell the split: it stays where it started and is no parameter.
+  const bool share_held = load && !covariance.allFinite();
+  if (share_held) {
+    // Friction too small to tell the split (a singular Jacobian): the share stays where LM left it
+    // and is no parameter; its std and those of the inertias are then unknown (NaN), not 0.
     fixed.push_back(kJl);
     covariance = free_covariance(best, known_std, fixed);
     held = "; the motor's share of the inertia is not seen (too little friction) and is held at " +
            std::to_string(motor_share(best.parameters)).substr(0, 5);
   }
+  const double dof = 2.0 * static_cast<double>(m) - static_cast<double>(layout.size) + static_cast<double>(fixed.size());
+  out.sigma2 = known_std ? 1.0 : best.residual.squaredNorm() / dof;
+  const detail::MisfitScale misfit = detail::misfit_scale(best.residual, dof, known_std);
+  out.uncertainty_scale = misfit.factor;
+  out.uncertainty_note = misfit.note;
   fill_estimates(out, best.parameters, covariance * misfit.factor, ctx, options.rigid);
+  if (share_held) out.motor_share.std = out.motor_inertia.std = out.load_inertia.std = kNan;
   out.note = std::string("two-mass model with Coulomb friction on motor and load (describing functions at each point's "
                          "measured amplitude") +
              (load ? ", seen from the load encoder" : "") + "), " + std::to_string(m) + " points" + held;

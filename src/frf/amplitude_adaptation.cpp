@@ -41,9 +41,8 @@ double AmplitudeAdapter::update(double thd, double usage, double omega_ts, doubl
     // The fast growth only while the SNR demands it (a stuck motor: no response to measure); a
     // THD demand alone keeps rc per period, since the THD estimate lags a fast-changing amplitude
     // and the relay would overshoot (tried: the frictionless bench went from 25 to 31 s).
-    const double per_second = snr_relay_ ? law_.growth_per_second : 0.0;
     if (law_.proportional)
-      amplitude_ *= std::max(std::pow(1.0 + law_.rate, periods), std::pow(1.0 + per_second, law_.ts));
+      amplitude_ *= std::max(std::pow(1.0 + law_.rate, periods), snr_relay_ ? per_sample_growth_ : 1.0);
     else amplitude_ += law_.rate * law_.initial * periods;
   }
   amplitude_ = std::clamp(amplitude_, 0.0, law_.maximum);

@@ -68,8 +68,10 @@ RfidParameters validated(RfidParameters p) {
   require_finite_positive(p.amplitude_rate, "amplitude_rate");
   if (!std::isfinite(p.max_settling_periods) || p.max_settling_periods < 0.0)
     reject("max_settling_periods", "0 (no limit by periods) or a finite value > 0", p.max_settling_periods);
-  if (!std::isfinite(p.amplitude_growth_per_second) || p.amplitude_growth_per_second < 0.0)
-    reject("amplitude_growth_per_second", "a finite value >= 0", p.amplitude_growth_per_second);
+  if (!std::isfinite(p.amplitude_growth_per_second) || p.amplitude_growth_per_second < 0.0 ||
+      (p.amplitude_growth_per_second > 0.0 && !p.proportional_growth))
+    reject("amplitude_growth_per_second", "a finite value >= 0, and 0 unless proportional_growth",
+           p.amplitude_growth_per_second);
   if (!std::isfinite(p.fade_in_periods) || p.fade_in_periods < 0.0 || p.fade_in_periods > 100.0)
     reject("fade_in_periods", "a value in [0, 100]", p.fade_in_periods);
   const bool min_inf = std::isinf(p.output_min) && p.output_min < 0.0;
@@ -146,9 +148,11 @@ long RfidBlock::period_samples(double omega) const noexcept {
 
 long RfidBlock::max_settle_limit() const noexcept {
   if (!(p_.max_settling_periods > 0.0)) return max_settle_samples_;
-  const auto by_periods = std::max(std::lround(p_.max_settling_periods * static_cast<double>(period_samples(omega_))),
-                                   std::lround(kMinimumPeriodLimit_s / p_.ts));
-  return std::min(max_settle_samples_, std::max(by_periods, settle_samples_ + 1));
+  // In double until it is known to lie below the time limit: a huge period count must mean "no
+  // limit by periods", not overflow.
+  const double by_periods = std::max(p_.max_settling_periods * kTwoPi / (omega_ * p_.ts), kMinimumPeriodLimit_s / p_.ts);
+  if (!(by_periods < static_cast<double>(max_settle_samples_))) return max_settle_samples_;
+  return std::max(std::lround(by_periods), settle_samples_ + 1);
 }
 
 void RfidBlock::start_run() noexcept {

@@ -85,6 +85,8 @@ json friction_json(const fit::CoulombFit& c) {
           {"viscous_damping_std", number_or_null(c.viscous_damping.std)},
           {"total_inertia", c.total_inertia.value},
           {"total_inertia_std", number_or_null(c.total_inertia.std)},
+          {"motor_share", c.motor_share.value},
+          {"motor_share_std", number_or_null(c.motor_share.std)},
           {"residual", c.rms_log_error},
           {"linear_residual", c.linear_rms_log_error},
           {"note", c.note}};

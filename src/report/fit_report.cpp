@@ -190,6 +190,7 @@ Section friction_section(const fit::CoulombFit& f) {
                                   {"load Coulomb friction Ml (input units)", with_std(f.load_coulomb)},
                                   {"motor viscous damping bv", with_std(f.viscous_damping)},
                                   {"total inertia Jm + Jl", with_std(f.total_inertia)},
+                                  {"motor's share Jm/(Jm + Jl)", with_std(f.motor_share)},
                                   {"rms |ln(P_model/P_meas)| with friction", num(f.rms_log_error, 4)},
                                   {"rms |ln(P_model/P_meas)| of the linear fit", num(f.linear_rms_log_error, 4)}}));
   return s;
@@ -212,10 +213,12 @@ Section response_section(const core::FrequencyResponse& measured, const fit::Pla
     p_meas.push_back(p.value);
     std::complex<double> model_value = model.response(kTwoPi * p.freq_hz);
     if (friction) {
-      model_value = fit::coulomb_response_at(*friction, p);
-      if (std::isfinite(model_value.real())) {
+      // Where the friction model has no value (a point without amplitude), the linear model's error.
+      const std::complex<double> with_friction = fit::coulomb_response_at(*friction, p);
+      if (std::isfinite(with_friction.real())) {
+        model_value = with_friction;
         f_friction.push_back(p.freq_hz);
-        p_friction.push_back(model_value);
+        p_friction.push_back(with_friction);
       }
     }
     rel_error.push_back(std::abs(model_value / p.value - 1.0));

@@ -40,8 +40,12 @@ machine::PlantConfig realize_plant_model(const fit::PlantModel& model, Realizati
     throw core::InputError(core::at_field("ts"), fmt::format("expected a sample period > 0 s, got {}", ts));
   machine::PlantConfig config;
   config.settings.ts = ts;
+  // A load-side model's output is the load's: a motor-feedback loop must not close on it
+  // (drive simulation refuses that pairing by the output kind).
   const bool position = model.output == fit::OutputKind::kPosition;
-  config.settings.output = position ? machine::PlantOutput::MotorPosition : machine::PlantOutput::MotorVelocity;
+  const bool load = model.sensor == fit::SensorSide::kLoad;
+  config.settings.output = position ? (load ? machine::PlantOutput::LoadPosition : machine::PlantOutput::MotorPosition)
+                                    : (load ? machine::PlantOutput::LoadVelocity : machine::PlantOutput::MotorVelocity);
   if (model.delay_s) {
     // A response measured on a sampled drive carries the zero-order hold's half-sample delay in the
     // fitted delay; the simulation holds its input too, so that half sample is not added twice.

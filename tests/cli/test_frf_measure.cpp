@@ -117,7 +117,7 @@ TEST_F(Cli, FitOfALoadEncodersResponse) {
   ASSERT_EQ(run("-q frf measure --plant bench.json --range-hz 1:500 -o frf.csv").status, 0);
   const Result motor = run("fit frf.csv --lag");
   EXPECT_EQ(motor.status, 3);
-  EXPECT_NE(motor.err.find("load sensor"), std::string::npos) << motor.err;
+  EXPECT_NE(motor.err.find("--sensor load"), std::string::npos) << motor.err;
   const Result load = run("fit frf.csv --sensor load --lag -o load.json");
   ASSERT_EQ(load.status, 0) << load.err;
   EXPECT_NE(load.out.find("load-side mode"), std::string::npos) << load.out;
@@ -130,6 +130,11 @@ TEST_F(Cli, FitOfALoadEncodersResponse) {
   EXPECT_EQ(tune.status, 3);
   EXPECT_NE(tune.err.find("load-side"), std::string::npos) << tune.err;
   EXPECT_FALSE(std::filesystem::exists(path("pi.json")));
+  // A motor-feedback controller must not close its loop on the load's response.
+  ASSERT_EQ(run("tune motor-bench --ts 0.000125 -o motor_pi.json").status, 0);
+  const Result sim = run("simulate --plant load.json --controller motor_pi.json --duration 1 -o s.csv");
+  EXPECT_EQ(sim.status, 3) << sim.out;
+  EXPECT_FALSE(std::filesystem::exists(path("s.csv")));
   EXPECT_EQ(run("fit frf.csv --sensor load --amplitude-series frf.csv").status, 3);
   const Result friction = run("fit frf.csv --sensor load --lag --friction");
   ASSERT_EQ(friction.status, 0) << friction.err;

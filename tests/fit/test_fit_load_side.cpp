@@ -91,7 +91,7 @@ TEST(LoadSide, FitsTheResonanceWhereTheMotorSideModelFindsNoAntiresonance) {
       fit_plant(r, {ModelRequest::Kind::kTwoMass, 1}, motor);
       ADD_FAILURE() << "the motor-side fit of a load-side response should fail";
     } catch (const core::InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("load sensor"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("load-side response"), std::string::npos) << e.what();
     }
     const FitReport f = fit_plant(r, {ModelRequest::Kind::kTwoMass, 1}, load_options());
     ASSERT_TRUE(f.result.converged) << f.result.message;

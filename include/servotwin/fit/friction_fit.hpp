@@ -28,7 +28,9 @@
 /// A load-side response's linear part does not tell Jm from Jl (it depends on J = Jm + Jl,
 /// k·J/(Jm Jl) and bs·J/(Jm Jl) only); the friction does, since the two describing functions act
 /// on different velocities. The share Jm/J is fitted from 1/2 and, when the friction is too small
-/// to tell it (a singular Jacobian), held there and said so in the note.
+/// to tell it (a singular Jacobian), held where LM left it (its std NaN) and said so in the note;
+/// short of that its std tells how well it is seen. (With the motor's viscous damping bv the
+/// linear part sees the split too, weakly.)
 /// Levenberg–Marquardt fits (ln Jm, ln Jl, ln k, ln bs, bv, Mm, Ml, and
 /// the lag pole and delay when the linear fit has them: friction bends its phase, and with it the
 /// lag) to the complex log errors of the points the linear fit used (its left-out points stay out),
@@ -65,8 +67,9 @@ struct CoulombFit {
   Estimate resonance_ratio;            ///< r = ωn/ωz of the linear part
   Estimate lag_pole_rad_s, delay_s;    ///< refitted with the friction (NaN when the linear fit has none)
   ModeUncertainty mode;                ///< antiresonance (NaN on the load side) and resonance of the linear part
-  /// θ = (ln Jm, ln Jl, ln k, ln bs, bv, Mm, Ml[, ln p][, T]) (scaled) at the solution and its
-  /// covariance (the linear fit's rule; the row and column of a bv held at 0 are zero).
+  /// θ = (ln Jm, ln Jl, ln k, ln bs, bv, Mm, Ml[, ln p][, T]) (scaled; on the load side
+  /// (ln J, logit Jm/J, ln k̃, ln b̃s, ...) with k = 4s(1 − s)k̃, bs = 4s(1 − s)b̃s) at the solution and
+  /// its covariance (the linear fit's rule; the rows and columns of a held bv or share are zero).
   Eigen::VectorXd theta;
   Eigen::MatrixXd covariance;
   std::string weighting;               ///< "std_dev" or "log-relative", as the linear fit's

@@ -5,6 +5,7 @@
 /// response is distorted or noisy; range protection holds or lowers it when the measured output
 /// or the actuator command approaches its limit. Arbitration: decrease > hold > increase.
 
+#include <cmath>
 #include <limits>
 
 namespace servotwin::frf {
@@ -35,7 +36,7 @@ struct AmplitudeLaw {
   /// 1 Hz to raise the amplitude 5.5 times, what a motor held by Coulomb friction above the
   /// excitation's level needs before it moves at all (issue 25 §1's 30 s).
   double growth_per_second = 0.0;
-  double ts = 0.0;  ///< sample period [s], for growth_per_second
+  double ts = 0.0;  ///< sample period [s], for growth_per_second (0: growth_per_second does not act)
 };
 
 /// What the arbitration decided in the last update.
@@ -44,7 +45,8 @@ enum class AmplitudeAction { kHold, kIncrease, kDecrease };
 /// The amplitude law, one update per sample, allocation- and exception-free.
 class AmplitudeAdapter {
  public:
-  explicit AmplitudeAdapter(const AmplitudeLaw& law) noexcept : law_(law), amplitude_(law.initial) {}
+  explicit AmplitudeAdapter(const AmplitudeLaw& law) noexcept
+      : law_(law), amplitude_(law.initial), per_sample_growth_(std::pow(1.0 + law.growth_per_second, law.ts)) {}
 
   /// Back to A(t0), relay off.
   void reset() noexcept;
@@ -68,6 +70,7 @@ class AmplitudeAdapter {
  private:
   AmplitudeLaw law_;
   double amplitude_;
+  double per_sample_growth_;  ///< (1 + growth_per_second)^ts, the SNR-driven growth per sample
   bool relay_ = false, thd_relay_ = false, snr_relay_ = false;
   AmplitudeAction action_ = AmplitudeAction::kHold;
 };
