@@ -103,12 +103,19 @@ void print_nonlinear(const fit::NonlinearMechanics& n) {
   fmt::print("    {}\n", n.backlash.note);
 }
 
+/// "a, b, c" of values with their std.
+std::string estimates(const std::vector<fit::Estimate>& v) {
+  std::string text;
+  for (const fit::Estimate& e : v) text += (text.empty() ? "" : ", ") + pm(e.value, e.std);
+  return text;
+}
+
 void print_friction(const fit::CoulombFit& c) {
   if (!c.fitted) {
     fmt::print("{}\n", c.note);
     return;
   }
-  const fit::Mode& m = c.model.modes.front();
+  const bool motor = c.model.sensor == fit::SensorSide::kMotor;
   fmt::print("with Coulomb friction ({}): rms log error {:.3g} (linear fit {:.3g}); {}\n", c.note, c.rms_log_error,
              c.linear_rms_log_error, c.message);
   fmt::print("  Coulomb friction motor Mm = {}, load Ml = {} (input units)\n", pm(c.motor_coulomb.value, c.motor_coulomb.std),
@@ -119,14 +126,23 @@ void print_friction(const fit::CoulombFit& c) {
                pm(c.rigid_pole_rad_s.value / kTwoPi, c.rigid_pole_rad_s.std / kTwoPi), c.viscous_damping.value);
   else
     fmt::print("  rigid           = integrator (no viscous damping found)\n");
-  if (c.model.sensor == fit::SensorSide::kMotor)
-    fmt::print("  mode 1: antiresonance {} Hz, zeta {}\n", pm(m.antiresonance.omega_rad_s / kTwoPi, c.mode.antiresonance_omega.std / kTwoPi),
-               pm(m.antiresonance.zeta, c.mode.antiresonance_zeta.std));
-  fmt::print("  {:<8}resonance     {} Hz, zeta {}\n", c.model.sensor == fit::SensorSide::kMotor ? "" : "mode 1:",
-             pm(m.resonance.omega_rad_s / kTwoPi, c.mode.resonance_omega.std / kTwoPi), pm(m.resonance.zeta, c.mode.resonance_zeta.std));
-  if (c.model.sensor == fit::SensorSide::kLoad) {
+  for (std::size_t i = 0; i < c.model.modes.size() && i < c.modes.size(); ++i) {
+    const fit::Mode& m = c.model.modes[i];
+    const fit::ModeUncertainty& u = c.modes[i];
+    if (motor)
+      fmt::print("  mode {}: antiresonance {} Hz, zeta {}\n", i + 1, pm(m.antiresonance.omega_rad_s / kTwoPi, u.antiresonance_omega.std / kTwoPi),
+                 pm(m.antiresonance.zeta, u.antiresonance_zeta.std));
+    fmt::print("  {:<8}resonance     {} Hz, zeta {}\n", motor ? "" : fmt::format("mode {}:", i + 1),
+               pm(m.resonance.omega_rad_s / kTwoPi, u.resonance_omega.std / kTwoPi), pm(m.resonance.zeta, u.resonance_zeta.std));
+  }
+  if (!motor) {
     fmt::print("  total inertia J = {}, motor's share Jm/J = {} (seen through the friction only)\n",
                pm(c.total_inertia.value, c.total_inertia.std), pm(c.motor_share.value, c.motor_share.std));
+    return;
+  }
+  if (c.stiffnesses.size() != 1) {
+    fmt::print("  inertias       = {} (motor first)\n  stiffnesses    = {}\n  shaft dampings = {}\n", estimates(c.inertias),
+               estimates(c.stiffnesses), estimates(c.shaft_dampings));
     return;
   }
   fmt::print("  motor inertia Im = {}\n  load inertia  Il = {}\n  stiffness     k  = {}\n  shaft damping b  = {}\n",
@@ -242,8 +258,9 @@ void register_fit(CLI::App& app, Action& selected) {
                   "largest): Coulomb friction and backlash from their describing functions")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--friction", a->friction,
-                "Also fit Coulomb friction on motor and load with --model two-mass (describing functions at each "
-                "point's excitation amplitude, swept-sine responses; either --sensor): friction is told apart from "
+                "Also fit Coulomb friction on motor and load (a mass chain of one mass more than the fitted modes, "
+                "motor side; one mode from the load side; describing functions at each point's excitation "
+                "amplitude, swept-sine responses): friction is told apart from "
                 "the linear damping, and -o writes the linear part");
   add_report_option(*cmd, a->report);
   set_examples(*cmd,

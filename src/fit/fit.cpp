@@ -377,11 +377,6 @@ void canonicalize(Eigen::VectorXd& t, Eigen::MatrixXd& c, const Layout& l) {
     }
 }
 
-Estimate log_estimate(const Eigen::VectorXd& t, const Eigen::MatrixXd& c, Eigen::Index i, double sign = 1.0) {
-  const double v = sign * std::exp(t[i]);
-  return {v, std::abs(v) * std::sqrt(c(i, i))};
-}
-
 /// The covariance factor of FitResult::uncertainty_scale, with its note (detail::misfit_scale).
 detail::MisfitScale misfit_scale(const Run& run, const Layout& l, const Data& data) {
   const std::size_t m = data.size();
@@ -418,16 +413,16 @@ FitResult finish(const Run& run, const Layout& l, const Data& data) {
     sum += e.real() * e.real() + std::pow(std::remainder(e.imag(), kTwoPi), 2);
   }
   f.rms_log_error = std::sqrt(sum / static_cast<double>(data.size()));
-  f.gain = log_estimate(t, c, 0, run.sign);
-  f.rigid_pole_rad_s = l.rigid == RigidKind::kRealPole ? log_estimate(t, c, l.rigid_index()) : Estimate{0.0, 0.0};
-  f.lag_pole_rad_s = l.lag ? log_estimate(t, c, l.lag_index()) : Estimate{kNan, kNan};
-  f.delay_s = l.delay ? log_estimate(t, c, l.delay_index()) : Estimate{kNan, kNan};
+  f.gain = detail::log_estimate(t, c, 0, run.sign);
+  f.rigid_pole_rad_s = l.rigid == RigidKind::kRealPole ? detail::log_estimate(t, c, l.rigid_index()) : Estimate{0.0, 0.0};
+  f.lag_pole_rad_s = l.lag ? detail::log_estimate(t, c, l.lag_index()) : Estimate{kNan, kNan};
+  f.delay_s = l.delay ? detail::log_estimate(t, c, l.delay_index()) : Estimate{kNan, kNan};
   for (std::size_t i = 0; i < l.modes; ++i) {
     const Eigen::Index b = l.mode_base(i), p = l.resonance_index(i);
     const bool motor = l.sensor == SensorSide::kMotor;
-    f.mode_estimates.push_back({motor ? log_estimate(t, c, b) : Estimate{kNan, kNan},
-                                motor ? log_estimate(t, c, b + 1) : Estimate{kNan, kNan}, log_estimate(t, c, p),
-                                log_estimate(t, c, p + 1)});
+    f.mode_estimates.push_back({motor ? detail::log_estimate(t, c, b) : Estimate{kNan, kNan},
+                                motor ? detail::log_estimate(t, c, b + 1) : Estimate{kNan, kNan}, detail::log_estimate(t, c, p),
+                                detail::log_estimate(t, c, p + 1)});
   }
   if (l.sensor == SensorSide::kLoad) {
     f.physical.note = "no two-mass parameters from a load-side response: its low-frequency gain gives the total inertia "
@@ -650,9 +645,7 @@ FitResult fit_model(const core::FrequencyResponse& response, std::size_t modes, 
   std::optional<Run> best;
   for (auto& [start, name] : starts) {
     Run run = refine(start, data, options, name);
-    const bool better = !best || (run.lm.converged() && !best->lm.converged()) ||
-                        (run.lm.converged() == best->lm.converged() && run.lm.cost < best->lm.cost);
-    if (better) best = std::move(run);
+    if (!best || detail::better_run(run.lm, best->lm)) best = std::move(run);
   }
   return finish(*best, l, data);
 }

@@ -1,5 +1,7 @@
 #include "servotwin/fit/friction_fit.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,6 +9,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <stdexcept>
 #include <vector>
 
 #include "friction_model.hpp"
@@ -23,15 +26,33 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kTwoPi = 2.0 * kPi;
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
-/// θ = (ln Jm, ln Jl, ln k, ln bs, bv/bv_ref, Mm/T_ref, Ml/T_ref[, ln p][, T ωz]): logs keep the
-/// positive quantities positive; the three that may be 0 are scaled to order one (T_ref the median
-/// excitation amplitude, bv_ref = Jm ωz of the start) so that LM's central differences and box
-/// bounds act on comparable numbers. The lag pole p and the delay T, when the linear fit has them,
-/// are fitted again: friction bends the linear fit's phase, and with it its lag. On the load side
-/// θ[kJm] is ln J (J = Jm + Jl), θ[kJl] the logit of the motor's share s = Jm/J, and k, bs carry
-/// the factor 4s(1 − s): the linear part's resonance (ωp² = k J/(Jm Jl)) is then free of s, which
-/// only the friction's describing functions tell (linear data leave it where it starts, 1/2).
-enum Index : Eigen::Index { kJm, kJl, kK, kBs, kBv, kMm, kMl, kCount };
+/// θ = (ln J1…ln Jn+1, ln k1…ln kn, ln b1…ln bn, bv/bv_ref, Mm/T_ref, Ml/T_ref[, ln p][, T ωz])
+/// for a chain of n shafts: logs keep the positive quantities positive; the three that may be 0
+/// are scaled to order one (T_ref the median excitation amplitude, bv_ref = J1 ωz of the start) so
+/// that LM's central differences and box bounds act on comparable numbers. The lag pole p and the
+/// delay T, when the linear fit has them, are fitted again: friction bends the linear fit's phase,
+/// and with it its lag. On the load side (one shaft) θ[0] is ln J (J = Jm + Jl), θ[1] the logit of
+/// the motor's share s = Jm/J, and k, bs carry the factor 4s(1 − s): the linear part's resonance
+/// (ωp² = k J/(Jm Jl)) is then free of s, which only the friction's describing functions tell
+/// (linear data leave it where it starts, 1/2).
+struct Layout {
+  std::size_t shafts = 1;
+  Eigen::Index lag = -1, delay = -1, size = 0;
+  Layout(const PlantModel& m, std::size_t n) : shafts(n), size(friction_count()) {
+    if (m.lag_pole_rad_s) lag = size++;
+    if (m.delay_s) delay = size++;
+  }
+  [[nodiscard]] Eigen::Index n() const { return static_cast<Eigen::Index>(shafts); }
+  [[nodiscard]] Eigen::Index inertia(std::size_t i) const { return static_cast<Eigen::Index>(i); }
+  [[nodiscard]] Eigen::Index stiffness(std::size_t i) const { return n() + 1 + static_cast<Eigen::Index>(i); }
+  [[nodiscard]] Eigen::Index damping(std::size_t i) const { return 2 * n() + 1 + static_cast<Eigen::Index>(i); }
+  /// The parameters held as logarithms (inertias, stiffnesses, dampings).
+  [[nodiscard]] Eigen::Index logs() const { return 3 * n() + 1; }
+  [[nodiscard]] Eigen::Index viscous() const { return logs(); }
+  [[nodiscard]] Eigen::Index motor_coulomb() const { return logs() + 1; }
+  [[nodiscard]] Eigen::Index load_coulomb() const { return logs() + 2; }
+  [[nodiscard]] Eigen::Index friction_count() const { return logs() + 3; }
+};
 
 /// What the residuals need besides θ.
 struct Context {
@@ -40,36 +61,39 @@ struct Context {
   double time = 1.0;      ///< 1/ωz of the start, the delay's unit
   PlantModel linear;      ///< the linear fit: output kind, lag and delay present or not
   SensorSide sensor = SensorSide::kMotor;
-};
-
-/// Where the lag and delay sit in θ (absent: -1), and θ's size.
-struct Layout {
-  Eigen::Index lag = -1, delay = -1, size = kCount;
-  explicit Layout(const PlantModel& m) {
-    if (m.lag_pole_rad_s) lag = size++;
-    if (m.delay_s) delay = size++;
-  }
+  Layout layout;
 };
 
 /// The linear fit's structure (output kind) with θ's lag and delay.
 PlantModel actuator_of(const Eigen::VectorXd& t, const Context& c) {
   PlantModel m;
   m.output = c.linear.output;
-  const Layout l(c.linear);
-  if (l.lag >= 0) m.lag_pole_rad_s = std::exp(t[l.lag]);
-  if (l.delay >= 0) m.delay_s = t[l.delay] * c.time;
+  if (c.layout.lag >= 0) m.lag_pole_rad_s = std::exp(t[c.layout.lag]);
+  if (c.layout.delay >= 0) m.delay_s = t[c.layout.delay] * c.time;
   return m;
 }
 
-/// The load side's share s = Jm/J from its logit θ[kJl].
-double motor_share(const Eigen::VectorXd& t) { return 1.0 / (1.0 + std::exp(-t[kJl])); }
+/// The load side's share s = Jm/J from its logit θ[1].
+double motor_share(const Eigen::VectorXd& t) { return 1.0 / (1.0 + std::exp(-t[1])); }
 
 ChainParameters physical_of(const Eigen::VectorXd& t, const Context& c) {
-  const double viscous = t[kBv] * c.viscous, mm = t[kMm] * c.torque, ml = t[kMl] * c.torque;
-  if (c.sensor == SensorSide::kMotor)
-    return {std::exp(t[kJm]), std::exp(t[kJl]), std::exp(t[kK]), std::exp(t[kBs]), viscous, mm, ml};
-  const double total = std::exp(t[kJm]), share = motor_share(t), q = 4.0 * share * (1.0 - share);
-  return {share * total, (1.0 - share) * total, q * std::exp(t[kK]), q * std::exp(t[kBs]), viscous, mm, ml};
+  const Layout& l = c.layout;
+  const double viscous = t[l.viscous()] * c.viscous, mm = t[l.motor_coulomb()] * c.torque;
+  const double ml = t[l.load_coulomb()] * c.torque;
+  if (c.sensor == SensorSide::kLoad) {
+    const double total = std::exp(t[0]), share = motor_share(t), q = 4.0 * share * (1.0 - share);
+    return detail::two_mass_chain(share * total, (1.0 - share) * total, q * std::exp(t[2]), q * std::exp(t[3]), viscous, mm, ml);
+  }
+  ChainParameters p;
+  for (std::size_t i = 0; i <= l.shafts; ++i) p.inertia.push_back(std::exp(t[l.inertia(i)]));
+  for (std::size_t i = 0; i < l.shafts; ++i) {
+    p.stiffness.push_back(std::exp(t[l.stiffness(i)]));
+    p.damping.push_back(std::exp(t[l.damping(i)]));
+  }
+  p.bv = viscous;
+  p.mm = mm;
+  p.ml = ml;
+  return p;
 }
 
 struct Point {
@@ -89,7 +113,7 @@ double velocity_of(const core::FrequencyPoint& q, OutputKind output) {
 }
 
 bool residuals(const Eigen::VectorXd& t, const std::vector<Point>& points, const Context& c, Eigen::VectorXd& r) {
-  if ((t.head<4>().array().abs() > 700.0).any()) return false;
+  if ((t.head(c.layout.logs()).array().abs() > 700.0).any()) return false;
   const ChainParameters p = physical_of(t, c);
   const PlantModel act = actuator_of(t, c);
   for (std::size_t k = 0; k < points.size(); ++k) {
@@ -157,14 +181,6 @@ void errors_in_variables(const Eigen::VectorXd& t, const Context& c, std::vector
   }
 }
 
-/// A run is better when it converged and the other did not, else when its cost is lower.
-bool better(const core::LmResult& run, const core::LmResult& best) {
-  if (run.status == core::LmStatus::kInvalidStart) return false;
-  if (!std::isfinite(best.cost)) return true;
-  if (run.converged() != best.converged()) return run.converged();
-  return run.cost < best.cost;
-}
-
 /// A value and its standard deviation from θ's covariance by the delta method, g = ∂value/∂θ.
 Estimate delta(double value, const Eigen::VectorXd& g, const Eigen::MatrixXd& c) {
   return {value, std::sqrt(std::max(0.0, g.dot(c * g)))};
@@ -184,69 +200,84 @@ Eigen::VectorXd gradient(const Eigen::VectorXd& t, F f) {
   return g;
 }
 
+/// A quantity of the linear part (one mode's frequency or damping, the rigid pole) as a function
+/// of θ, for the delta method; NaN where a perturbed θ loses the mode.
+enum class Modal { kAntiresonanceOmega, kAntiresonanceZeta, kResonanceOmega, kResonanceZeta, kRigidPole, kRatio };
+
+double modal_value(const PlantModel& lp, std::size_t mode, Modal which) {
+  if (which == Modal::kRigidPole) return lp.rigid_pole_rad_s;
+  if (mode >= lp.modes.size()) return kNan;
+  const Mode& m = lp.modes[mode];
+  switch (which) {
+    case Modal::kAntiresonanceOmega: return m.antiresonance.omega_rad_s;
+    case Modal::kAntiresonanceZeta: return m.antiresonance.zeta;
+    case Modal::kResonanceOmega: return m.resonance.omega_rad_s;
+    case Modal::kResonanceZeta: return m.resonance.zeta;
+    default: return m.resonance.omega_rad_s / m.antiresonance.omega_rad_s;
+  }
+}
+
 void fill_estimates(CoulombFit& out, const Eigen::VectorXd& t, const Eigen::MatrixXd& c, const Context& ctx, RigidKind rigid) {
   const ChainParameters p = physical_of(t, ctx);
+  const Layout& l = ctx.layout;
   const bool load = ctx.sensor == SensorSide::kLoad;
-  auto log_param = [&](Index i) {
-    return Estimate{std::exp(t[i]), std::exp(t[i]) * std::sqrt(std::max(0.0, c(i, i)))};
-  };
-  auto scaled_param = [&](Index i, double scale) {
+  auto scaled_param = [&](Eigen::Index i, double scale) {
     return Estimate{t[i] * scale, scale * std::sqrt(std::max(0.0, c(i, i)))};
   };
   // On the load side the inertias, k and bs are functions of θ: delta method.
-  const auto physical = [&](double ChainParameters::*member) {
-    const auto value = [&](const Eigen::VectorXd& x) { return physical_of(x, ctx).*member; };
-    return delta(p.*member, gradient(t, value), c);
+  const auto physical = [&](std::vector<double> ChainParameters::*member, std::size_t i) {
+    const auto value = [&, member, i](const Eigen::VectorXd& x) { return (physical_of(x, ctx).*member)[i]; };
+    return delta((p.*member)[i], gradient(t, value), c);
   };
-  out.motor_inertia = load ? physical(&ChainParameters::jm) : log_param(kJm);
-  out.load_inertia = load ? physical(&ChainParameters::jl) : log_param(kJl);
-  out.stiffness = load ? physical(&ChainParameters::k) : log_param(kK);
-  out.shaft_damping = load ? physical(&ChainParameters::bs) : log_param(kBs);
-  out.total_inertia = load ? log_param(kJm) : Estimate{p.jm + p.jl, kNan};
+  out.inertias.clear();
+  out.stiffnesses.clear();
+  out.shaft_dampings.clear();
+  for (std::size_t i = 0; i <= l.shafts; ++i)
+    out.inertias.push_back(load ? physical(&ChainParameters::inertia, i) : detail::log_estimate(t, c, l.inertia(i)));
+  for (std::size_t i = 0; i < l.shafts; ++i) {
+    out.stiffnesses.push_back(load ? physical(&ChainParameters::stiffness, i) : detail::log_estimate(t, c, l.stiffness(i)));
+    out.shaft_dampings.push_back(load ? physical(&ChainParameters::damping, i) : detail::log_estimate(t, c, l.damping(i)));
+  }
+  out.motor_inertia = out.inertias.front();
+  out.load_inertia = out.inertias.back();
+  out.stiffness = l.shafts == 1 ? out.stiffnesses.front() : Estimate{kNan, kNan};
+  out.shaft_damping = l.shafts == 1 ? out.shaft_dampings.front() : Estimate{kNan, kNan};
+  out.total_inertia = load ? detail::log_estimate(t, c, 0) : Estimate{p.total_inertia(), kNan};
   if (load) {
     const double share = motor_share(t);
-    out.motor_share = {share, share * (1.0 - share) * std::sqrt(std::max(0.0, c(kJl, kJl)))};
+    out.motor_share = {share, share * (1.0 - share) * std::sqrt(std::max(0.0, c(1, 1)))};
   } else {
-    out.motor_share = {p.jm / (p.jm + p.jl), kNan};
+    out.motor_share = {p.inertia.front() / p.total_inertia(), kNan};
   }
-  out.viscous_damping = scaled_param(kBv, ctx.viscous);
-  out.motor_coulomb = scaled_param(kMm, ctx.torque);
-  out.load_coulomb = scaled_param(kMl, ctx.torque);
+  out.viscous_damping = scaled_param(l.viscous(), ctx.viscous);
+  out.motor_coulomb = scaled_param(l.motor_coulomb(), ctx.torque);
+  out.load_coulomb = scaled_param(l.load_coulomb(), ctx.torque);
   out.model = detail::chain_linear_part(p, actuator_of(t, ctx), rigid, ctx.sensor);
-  const Layout l(ctx.linear);
-  // K = p/Jm (p/(Jm + Jl) on the load side; without a lag p = 1): ln K = ln p − θ[kJm].
-  double var_ln_gain = c(kJm, kJm);
-  if (l.lag >= 0) var_ln_gain += c(l.lag, l.lag) - 2.0 * c(kJm, l.lag);
+  // K = p/J1 (p/ΣJ on the load side; without a lag p = 1): ln K = ln p − θ[0].
+  double var_ln_gain = c(0, 0);
+  if (l.lag >= 0) var_ln_gain += c(l.lag, l.lag) - 2.0 * c(0, l.lag);
   out.gain = {out.model.gain, out.model.gain * std::sqrt(std::max(0.0, var_ln_gain))};
-  out.lag_pole_rad_s = l.lag >= 0 ? log_param(static_cast<Index>(l.lag)) : Estimate{kNan, kNan};
-  out.delay_s = l.delay >= 0 ? scaled_param(static_cast<Index>(l.delay), ctx.time) : Estimate{kNan, kNan};
+  out.lag_pole_rad_s = l.lag >= 0 ? detail::log_estimate(t, c, l.lag) : Estimate{kNan, kNan};
+  out.delay_s = l.delay >= 0 ? scaled_param(l.delay, ctx.time) : Estimate{kNan, kNan};
   out.theta = t;
   out.covariance = c;
-  auto modal = [&](int which) {
-    return [&, which](const Eigen::VectorXd& x) {
-      const PlantModel lp = detail::chain_linear_part(physical_of(x, ctx), actuator_of(x, ctx), rigid, ctx.sensor);
-      const Mode& m = lp.modes.front();
-      switch (which) {
-        case 0: return m.antiresonance.omega_rad_s;
-        case 1: return m.antiresonance.zeta;
-        case 2: return m.resonance.omega_rad_s;
-        case 3: return m.resonance.zeta;
-        case 4: return lp.rigid_pole_rad_s;
-        default: return m.resonance.omega_rad_s / m.antiresonance.omega_rad_s;
-      }
+  const auto estimate = [&](std::size_t mode, Modal which) {
+    const auto value = [&, mode, which](const Eigen::VectorXd& x) {
+      return modal_value(detail::chain_linear_part(physical_of(x, ctx), actuator_of(x, ctx), rigid, ctx.sensor), mode, which);
     };
+    return delta(modal_value(out.model, mode, which), gradient(t, value), c);
   };
-  const Mode& m = out.model.modes.front();
-  out.mode.resonance_omega = delta(m.resonance.omega_rad_s, gradient(t, modal(2)), c);
-  out.mode.resonance_zeta = delta(m.resonance.zeta, gradient(t, modal(3)), c);
-  out.rigid_pole_rad_s = delta(out.model.rigid_pole_rad_s, gradient(t, modal(4)), c);
-  if (load) {
-    out.mode.antiresonance_omega = out.mode.antiresonance_zeta = out.resonance_ratio = {kNan, kNan};
-    return;
+  out.rigid_pole_rad_s = estimate(0, Modal::kRigidPole);
+  out.modes.clear();
+  for (std::size_t i = 0; i < out.model.modes.size(); ++i) {
+    ModeUncertainty u;
+    u.resonance_omega = estimate(i, Modal::kResonanceOmega);
+    u.resonance_zeta = estimate(i, Modal::kResonanceZeta);
+    u.antiresonance_omega = load ? Estimate{kNan, kNan} : estimate(i, Modal::kAntiresonanceOmega);
+    u.antiresonance_zeta = load ? Estimate{kNan, kNan} : estimate(i, Modal::kAntiresonanceZeta);
+    out.modes.push_back(u);
   }
-  out.mode.antiresonance_omega = delta(m.antiresonance.omega_rad_s, gradient(t, modal(0)), c);
-  out.mode.antiresonance_zeta = delta(m.antiresonance.zeta, gradient(t, modal(1)), c);
-  out.resonance_ratio = delta(m.resonance.omega_rad_s / m.antiresonance.omega_rad_s, gradient(t, modal(5)), c);
+  out.resonance_ratio = load || l.shafts != 1 ? Estimate{kNan, kNan} : estimate(0, Modal::kRatio);
 }
 
 /// The points the linear fit used (valid, not left out as outliers), with their weights; empty with
@@ -275,29 +306,44 @@ std::vector<Point> fitted_points(const core::FrequencyResponse& response, const 
   return points;
 }
 
-/// The chain the linear fit describes, without friction: its physical parameters on the motor
-/// side; on the load side the total inertia 1/K' and the resonance, split by `motor_fraction`
-/// (ωp² = k J/(Jm Jl), 2ζp ωp = bs J/(Jm Jl)). Empty with `why` when there is none.
+/// "two-mass model", "three-mass chain", "4-mass chain".
+std::string chain_name(std::size_t shafts) {
+  if (shafts == 1) return "two-mass model";
+  return (shafts == 2 ? std::string("three") : std::to_string(shafts + 1)) + "-mass chain";
+}
+
+/// The chain the linear fit describes, without friction: on the motor side its two-mass
+/// parameters for one mode, Cauer's chain of its undamped modes for more (detail::chain_of_modes);
+/// on the load side (one mode) the total inertia 1/K' and the resonance, split by
+/// `motor_fraction` (ωp² = k J/(Jm Jl), 2ζp ωp = bs J/(Jm Jl)). Empty with `why` when there is none.
 std::optional<ChainParameters> linear_chain(const FitReport& linear, double motor_fraction, std::string& why) {
   const PlantModel& lin = linear.result.model;
+  const double lag = lin.lag_pole_rad_s ? *lin.lag_pole_rad_s : 1.0;
+  if (lin.sensor == SensorSide::kMotor && lin.modes.size() > 1) {
+    std::optional<ChainParameters> chain = detail::chain_of_modes(lin.modes, lin.gain / lag, why);
+    if (!chain) why = "Coulomb friction not fitted: the linear fit has no mass-chain reading (" + why + ")";
+    return chain;
+  }
   if (lin.sensor == SensorSide::kMotor) {
     const auto& start = linear.result.physical.parameters;
     if (!start) {
       why = "Coulomb friction not fitted: the linear fit has no two-mass parameters (" + linear.result.physical.note + ")";
       return std::nullopt;
     }
-    return ChainParameters{start->motor_inertia.value, start->load_inertia.value, start->stiffness.value,
-                           start->damping.value, 0.0, 0.0, 0.0};
+    return detail::two_mass_chain(start->motor_inertia.value, start->load_inertia.value, start->stiffness.value,
+                                  start->damping.value, 0.0, 0.0, 0.0);
   }
   if (lin.modes.size() != 1 || !(lin.gain > 0.0)) {
-    why = "Coulomb friction not fitted: the load-side fit needs one mode and a positive gain (it has " +
-          std::to_string(lin.modes.size()) + " mode(s))";
+    why = "Coulomb friction not fitted: a load-side fit needs one mode and a positive gain (it has " +
+          std::to_string(lin.modes.size()) +
+          " mode(s); a longer chain seen from the load does not tell its inertias and stiffnesses apart)";
     return std::nullopt;
   }
-  const double total = (lin.lag_pole_rad_s ? *lin.lag_pole_rad_s : 1.0) / lin.gain;
+  const double total = lag / lin.gain;
   const double jm = motor_fraction * total, jl = (1.0 - motor_fraction) * total, mu = jm * jl / total;
   const ModalPair& res = lin.modes.front().resonance;
-  return ChainParameters{jm, jl, res.omega_rad_s * res.omega_rad_s * mu, 2.0 * res.zeta * res.omega_rad_s * mu, 0.0, 0.0, 0.0};
+  return detail::two_mass_chain(jm, jl, res.omega_rad_s * res.omega_rad_s * mu, 2.0 * res.zeta * res.omega_rad_s * mu, 0.0,
+                                0.0, 0.0);
 }
 
 }  // namespace
@@ -305,15 +351,25 @@ std::optional<ChainParameters> linear_chain(const FitReport& linear, double moto
 std::complex<double> coulomb_two_mass_response(double omega_rad_s, double motor_velocity_amplitude, double jm, double jl,
                                                double k, double bs, double bv, double mm, double ml,
                                                const PlantModel& linear_model) {
-  return detail::chain_response(omega_rad_s, motor_velocity_amplitude, {jm, jl, k, bs, bv, mm, ml}, linear_model,
-                                SensorSide::kMotor);
+  return detail::chain_response(omega_rad_s, motor_velocity_amplitude, detail::two_mass_chain(jm, jl, k, bs, bv, mm, ml),
+                                linear_model, SensorSide::kMotor);
 }
 
 std::complex<double> coulomb_two_mass_load_response(double omega_rad_s, double load_velocity_amplitude, double jm, double jl,
                                                     double k, double bs, double bv, double mm, double ml,
                                                     const PlantModel& linear_model) {
-  return detail::chain_response(omega_rad_s, load_velocity_amplitude, {jm, jl, k, bs, bv, mm, ml}, linear_model,
-                                SensorSide::kLoad);
+  return detail::chain_response(omega_rad_s, load_velocity_amplitude, detail::two_mass_chain(jm, jl, k, bs, bv, mm, ml),
+                                linear_model, SensorSide::kLoad);
+}
+
+std::complex<double> coulomb_chain_response(double omega_rad_s, double velocity_amplitude, const std::vector<double>& inertias,
+                                            const std::vector<double>& stiffnesses, const std::vector<double>& dampings,
+                                            double bv, double mm, double ml, const PlantModel& linear_model,
+                                            SensorSide sensor) {
+  if (inertias.size() < 2 || stiffnesses.size() + 1 != inertias.size() || dampings.size() != stiffnesses.size())
+    throw std::invalid_argument("coulomb_chain_response: n + 1 inertias need n stiffnesses and n dampings");
+  return detail::chain_response(omega_rad_s, velocity_amplitude, {inertias, stiffnesses, dampings, bv, mm, ml},
+                                linear_model, sensor);
 }
 
 CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const FitReport& linear, const FitOptions& options) {
@@ -326,11 +382,11 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   std::vector<Point> points = fitted_points(response, linear, lin.output, amplitudes, known_std, out.note);
   if (!out.note.empty()) return out;
   const std::size_t m = points.size();
-  const Layout layout(lin);
+  const Layout layout(lin, start->shafts());
   const bool load = lin.sensor == SensorSide::kLoad;
   const bool fixed_integrator = options.rigid == RigidKind::kIntegrator;
   std::vector<Eigen::Index> fixed;
-  if (fixed_integrator) fixed.push_back(kBv);
+  if (fixed_integrator) fixed.push_back(layout.viscous());
   const auto free_parameters = static_cast<std::size_t>(layout.size) - fixed.size();
   if (2 * m <= free_parameters) {
     out.note = "Coulomb friction not fitted: " + std::to_string(m) + " points are too few for " +
@@ -339,9 +395,11 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   }
   const double lowest_amplitude = amplitudes.front();
   std::nth_element(amplitudes.begin(), amplitudes.begin() + static_cast<std::ptrdiff_t>(m / 2), amplitudes.end());
-  const double jm0 = start->jm, jl0 = start->jl, k0 = start->k;
-  const double wz0 = std::sqrt(k0 / jl0);
-  const Context ctx{jm0 * wz0, amplitudes[m / 2], 1.0 / wz0, lin, lin.sensor};
+  const double jm0 = start->inertia.front(), total0 = start->total_inertia();
+  // The first antiresonance, the unit of the viscous damping and the delay (two masses: √(k/Jl)).
+  const double wz0 = start->shafts() == 1 ? std::sqrt(start->stiffness.front() / start->inertia.back())
+                                          : lin.modes.front().antiresonance.omega_rad_s;
+  const Context ctx{jm0 * wz0, amplitudes[m / 2], 1.0 / wz0, lin, lin.sensor, layout};
 
   core::LmOptions lo;
   lo.numeric_jacobian = true;
@@ -351,14 +409,14 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   lo.lower = Eigen::VectorXd::Constant(layout.size, -std::numeric_limits<double>::infinity());
   lo.upper = Eigen::VectorXd::Constant(layout.size, std::numeric_limits<double>::infinity());
   if (layout.delay >= 0) (*lo.lower)[layout.delay] = 0.0;
-  (*lo.lower)[kBv] = 0.0;
-  (*lo.lower)[kMm] = 0.0;
-  (*lo.lower)[kMl] = 0.0;
-  if (fixed_integrator) (*lo.upper)[kBv] = 0.0;
+  (*lo.lower)[layout.viscous()] = 0.0;
+  (*lo.lower)[layout.motor_coulomb()] = 0.0;
+  (*lo.lower)[layout.load_coulomb()] = 0.0;
+  if (fixed_integrator) (*lo.upper)[layout.viscous()] = 0.0;
   if (load) {
     // The share within [0.007, 0.993]: a chain whose one mass vanishes is not a two-mass chain.
-    (*lo.lower)[kJl] = -5.0;
-    (*lo.upper)[kJl] = 5.0;
+    (*lo.lower)[1] = -5.0;
+    (*lo.upper)[1] = 5.0;
   }
   const auto f = [&](const Eigen::VectorXd& t, Eigen::VectorXd& res, Eigen::MatrixXd*) {
     return residuals(t, points, ctx, res);
@@ -367,24 +425,34 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   // Starts: the linear fit's parameters read without friction (its rigid pole as viscous damping),
   // and the same with that damping read as Coulomb friction, split evenly between the masses or all
   // on the load: at the lowest point the describing function 4M/(π|V|) equals the viscous
-  // a·(Jm + Jl). An integrator fit has no such damping to read; its friction starts at half the
+  // a·ΣJ. An integrator fit has no such damping to read; its friction starts at half the
   // lowest point's excitation amplitude, where friction shows most.
   const double a = lin.rigid == RigidKind::kRealPole ? lin.rigid_pole_rad_s : 0.0;
-  const double bv0 = fixed_integrator ? 0.0 : a * (jm0 + jl0);
-  const double m0 = a > 0.0 ? kPi * points.front().velocity * a * (jm0 + jl0) / 4.0 : 0.5 * lowest_amplitude;
+  const double bv0 = fixed_integrator ? 0.0 : a * total0;
+  const double m0 = a > 0.0 ? kPi * points.front().velocity * a * total0 / 4.0 : 0.5 * lowest_amplitude;
   const std::array<std::array<double, 3>, 3> starts{{{bv0, 0.0, 0.0}, {0.0, 0.5 * m0, 0.5 * m0}, {0.0, 0.0, m0}}};
   core::LmResult best;
   best.cost = std::numeric_limits<double>::infinity();
   for (const auto& [bv, mm, ml] : starts) {
     Eigen::VectorXd t(layout.size);
-    t.head<kCount>() << std::log(load ? jm0 + jl0 : jm0), load ? 0.0 : std::log(jl0), std::log(k0),
-        std::log(std::max(start->bs, 1e-6 * jm0 * wz0)), bv / ctx.viscous, mm / ctx.torque, ml / ctx.torque;
+    for (std::size_t i = 0; i <= layout.shafts; ++i) t[layout.inertia(i)] = std::log(start->inertia[i]);
+    if (load) {
+      t[0] = std::log(total0);
+      t[1] = 0.0;
+    }
+    for (std::size_t i = 0; i < layout.shafts; ++i) {
+      t[layout.stiffness(i)] = std::log(start->stiffness[i]);
+      t[layout.damping(i)] = std::log(std::max(start->damping[i], 1e-6 * jm0 * wz0));
+    }
+    t[layout.viscous()] = bv / ctx.viscous;
+    t[layout.motor_coulomb()] = mm / ctx.torque;
+    t[layout.load_coulomb()] = ml / ctx.torque;
     // A lag the linear fit pushed far above the data (it traded it for the friction's phase) has
     // no gradient left there; it starts at most a decade above the highest point.
     if (layout.lag >= 0) t[layout.lag] = std::log(std::min(*lin.lag_pole_rad_s, 10.0 * points.back().omega));
     if (layout.delay >= 0) t[layout.delay] = *lin.delay_s / ctx.time;
     core::LmResult run = core::levenberg_marquardt(f, t, 2 * m, lo);
-    if (better(run, best)) best = std::move(run);
+    if (detail::better_run(run, best)) best = std::move(run);
   }
   out.points = m;
   if (!std::isfinite(best.cost) || !best.converged()) {
@@ -412,7 +480,7 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   if (share_held) {
     // Friction too small to tell the split (a singular Jacobian): the share stays where LM left it
     // and is no parameter; its std and those of the inertias are then unknown (NaN), not 0.
-    fixed.push_back(kJl);
+    fixed.push_back(1);
     covariance = free_covariance(best, known_std, fixed);
     held = "; the motor's share of the inertia is not seen (too little friction) and is held at " +
            std::to_string(motor_share(best.parameters)).substr(0, 5);
@@ -424,8 +492,8 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   out.uncertainty_note = misfit.note;
   fill_estimates(out, best.parameters, covariance * misfit.factor, ctx, options.rigid);
   if (share_held) out.motor_share.std = out.motor_inertia.std = out.load_inertia.std = kNan;
-  out.note = std::string("two-mass model with Coulomb friction on motor and load (describing functions at each point's "
-                         "measured amplitude") +
+  out.note = chain_name(layout.shafts) +
+             " with Coulomb friction on motor and load (describing functions at each point's measured amplitude" +
              (load ? ", seen from the load encoder" : "") + "), " + std::to_string(m) + " points" + held;
   return out;
 }
@@ -437,10 +505,21 @@ FitReport with_friction_model(FitReport linear, const CoulombFit& f) {
   r.model = f.model;
   r.gain = f.gain;
   r.rigid_pole_rad_s = f.model.rigid == RigidKind::kRealPole ? f.rigid_pole_rad_s : Estimate{0.0, 0.0};
-  r.mode_estimates = {f.mode};
-  r.parameter_names = {load ? "ln_total_inertia" : "ln_motor_inertia", load ? "logit_motor_share" : "ln_load_inertia",
-                       load ? "ln_stiffness_at_even_share" : "ln_stiffness", load ? "ln_shaft_damping_at_even_share" : "ln_shaft_damping", "viscous_damping_scaled", "motor_coulomb_scaled",
-                       "load_coulomb_scaled"};
+  r.mode_estimates = f.modes;
+  const std::size_t shafts = f.stiffnesses.size();
+  if (load) {
+    r.parameter_names = {"ln_total_inertia", "logit_motor_share", "ln_stiffness_at_even_share",
+                         "ln_shaft_damping_at_even_share"};
+  } else if (shafts == 1) {
+    r.parameter_names = {"ln_motor_inertia", "ln_load_inertia", "ln_stiffness", "ln_shaft_damping"};
+  } else {
+    r.parameter_names.clear();
+    for (std::size_t i = 1; i <= shafts + 1; ++i) r.parameter_names.push_back("ln_inertia_" + std::to_string(i));
+    for (std::size_t i = 1; i <= shafts; ++i) r.parameter_names.push_back("ln_stiffness_" + std::to_string(i));
+    for (std::size_t i = 1; i <= shafts; ++i) r.parameter_names.push_back("ln_shaft_damping_" + std::to_string(i));
+  }
+  for (const char* name : {"viscous_damping_scaled", "motor_coulomb_scaled", "load_coulomb_scaled"})
+    r.parameter_names.emplace_back(name);
   if (f.model.lag_pole_rad_s) r.parameter_names.emplace_back("ln_lag_pole");
   if (f.model.delay_s) r.parameter_names.emplace_back("delay_scaled");
   r.theta = f.theta;
@@ -465,6 +544,18 @@ FitReport with_friction_model(FitReport linear, const CoulombFit& f) {
                       " and the motor's share " + std::to_string(f.motor_share.value);
     return linear;
   }
+  if (shafts != 1) {
+    const auto list = [](const std::vector<Estimate>& v) {
+      std::string text;
+      for (const Estimate& e : v) text += (text.empty() ? "" : ", ") + fmt::format("{:.5g}", e.value);
+      return text;
+    };
+    r.physical.parameters.reset();
+    r.physical.note = "not a two-mass system; the fit with Coulomb friction gives the " + chain_name(shafts) +
+                      ": inertias " + list(f.inertias) + ", stiffnesses " + list(f.stiffnesses) + ", shaft dampings " +
+                      list(f.shaft_dampings) + " (motor first)";
+    return linear;
+  }
   TwoMassParameters p;
   p.motor_inertia = f.motor_inertia;
   p.load_inertia = f.load_inertia;
@@ -483,10 +574,14 @@ FitReport with_friction_model(FitReport linear, const CoulombFit& f) {
 std::complex<double> coulomb_response_at(const CoulombFit& f, const core::FrequencyPoint& point) {
   const double v = velocity_of(point, f.model.output);
   if (!f.fitted || !(v > 0.0) || !std::isfinite(v)) return {kNan, 0.0};
-  return detail::chain_response(kTwoPi * point.freq_hz, v,
-                                {f.motor_inertia.value, f.load_inertia.value, f.stiffness.value, f.shaft_damping.value,
-                                 f.viscous_damping.value, f.motor_coulomb.value, f.load_coulomb.value},
-                                f.model, f.model.sensor);
+  detail::ChainParameters p;
+  p.bv = f.viscous_damping.value;
+  p.mm = f.motor_coulomb.value;
+  p.ml = f.load_coulomb.value;
+  for (const Estimate& e : f.inertias) p.inertia.push_back(e.value);
+  for (const Estimate& e : f.stiffnesses) p.stiffness.push_back(e.value);
+  for (const Estimate& e : f.shaft_dampings) p.damping.push_back(e.value);
+  return detail::chain_response(kTwoPi * point.freq_hz, v, p, f.model, f.model.sensor);
 }
 
 }  // namespace servotwin::fit

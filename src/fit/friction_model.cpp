@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <vector>
+#include <numeric>
 
 #include "servotwin/core/polynomial.hpp"
 
@@ -24,48 +24,139 @@ Complex actuator_response(const PlantModel& m, double omega) {
   return a;
 }
 
-/// The load's velocity over the motor's, G = Z/(Jl s + cl + Z), with cl = 4Ml/(π|Vl|) and
-/// |Vl| = |G|·|Vm|. Writing Jl s + Z = bs + jX (X = Jl ω − k/ω) and c = 4Ml/π, |Vl| = x solves
-/// x²((bs + c/x)² + X²) = |Vm|²|Z|², i.e. (bs² + X²)x² + 2 bs c x + c² − |Vm|²|Z|² = 0, whose
-/// positive root exists when |Vm||Z| > c; otherwise the load sticks (G = 0).
-Complex load_over_motor(double omega, double vm, const ChainParameters& p) {
-  const Complex z(p.bs, -p.k / omega);
-  const double x_reactance = p.jl * omega - p.k / omega;
-  const double c = 4.0 * p.ml / kPi;
-  if (c == 0.0) return z / (Complex(0.0, p.jl * omega) + z);
-  const double drive = vm * std::abs(z);
-  if (drive <= std::abs(c) && c > 0.0) return 0.0;
-  const double a2 = p.bs * p.bs + x_reactance * x_reactance;
-  const double disc = p.bs * p.bs * c * c - a2 * (c * c - drive * drive);
-  // The positive root in a form without cancellation: for c > 0 near sticking (drive → c) the
-  // textbook (−bs·c + √disc)/a2 subtracts two nearly equal numbers; for c < 0 (a trial step of
-  // the numerical Jacobian below the bound) the textbook form is the stable one.
-  const double root = std::sqrt(std::max(disc, 0.0));
-  const double x = c > 0.0 ? (drive - c) * (drive + c) / (p.bs * c + root) : (-p.bs * c + root) / a2;
-  if (!(x > 0.0)) return 0.0;
-  return z / (Complex(p.bs + c / x, x_reactance));
+/// The motor's velocity and the first shaft's force, per unit load velocity.
+struct MotorEnd {
+  Complex velocity, force;
+};
+
+/// Walks the chain from the load to the motor at s: the load moves with velocity 1 against its
+/// inertia and the describing function `cl` of its friction; each shaft i (impedance
+/// bi + ki/s) carries the force of everything beyond it, so the next mass inward moves by that
+/// force over the shaft's impedance more. With `load_held` the load stands still (it sticks) and
+/// the last shaft carries a unit force instead. Both results are affine in cl.
+MotorEnd walk_to_motor(Complex s, const ChainParameters& p, double cl, bool load_held) {
+  const std::size_t n = p.shafts();
+  Complex u = load_held ? 0.0 : 1.0;
+  Complex f = load_held ? Complex(1.0) : (p.inertia[n] * s + cl) * u;
+  for (std::size_t i = n; i-- > 0;) {
+    u += f / (p.damping[i] + p.stiffness[i] / s);
+    if (i == 0) break;
+    f += p.inertia[i] * s * u;
+  }
+  return {u, f};
+}
+
+/// The load's velocity amplitude x = |Vl| for a measured motor amplitude |Vm|. The walk gives
+/// Vm/Vl = A + B·cl with cl = c/x (c = 4Ml/π), so x|A + Bc/x| = |Vm|, i.e.
+/// |A|²x² + 2Re(A B̄)c x + |B|²c² − |Vm|² = 0, whose positive root exists when |Vm| > |B|c;
+/// otherwise the load sticks (nullopt). For one shaft |B| = 1/|Z|: the load breaks away when the
+/// shaft's force |Vm||Z| exceeds its friction.
+std::optional<double> load_amplitude(Complex s, double vm, const ChainParameters& p, double c) {
+  const Complex a = walk_to_motor(s, p, 0.0, false).velocity;
+  const Complex b = walk_to_motor(s, p, 1.0, false).velocity - a;
+  const double a2 = std::norm(a), beta = (a * std::conj(b)).real() * c, gamma = std::norm(b) * c * c - vm * vm;
+  const double disc = beta * beta - a2 * gamma;
+  if (gamma >= 0.0) {
+    // |Vm| ≤ |B|c: sticks for c > 0; for c < 0 (a trial step of the numerical Jacobian below the
+    // bound) the larger root.
+    if (c > 0.0 || disc < 0.0) return std::nullopt;
+    const double x = (-beta + std::sqrt(disc)) / a2;
+    return x > 0.0 ? std::optional<double>(x) : std::nullopt;
+  }
+  // The positive root without cancellation: x = −γ/(β + √disc) (√disc > |β| when γ < 0).
+  const double x = -gamma / (beta + std::sqrt(disc));
+  return x > 0.0 && std::isfinite(x) ? std::optional<double>(x) : std::nullopt;
 }
 
 /// Motor encoder: the motor's describing function from the measured |Vm|, the load's by the
-/// closed-form balance above; P = L/(Jm s + bv + 4Mm/(π|Vm|) + Z(1 − G)).
+/// closed-form balance above; P = L·Vm/((J1 s + bv + 4Mm/(π|Vm|))Vm + F1), F1 the first shaft's
+/// force.
 Complex motor_side(double omega, double vm, const ChainParameters& p) {
-  const Complex s(0.0, omega), z(p.bs, -p.k / omega);
-  return 1.0 / (p.jm * s + p.bv + 4.0 * p.mm / (kPi * vm) + z * (1.0 - load_over_motor(omega, vm, p)));
+  const Complex s(0.0, omega);
+  const double c = 4.0 * p.ml / kPi;
+  std::optional<double> x;
+  if (c != 0.0) x = load_amplitude(s, vm, p, c);
+  const MotorEnd e = c == 0.0 ? walk_to_motor(s, p, 0.0, false)
+                     : x      ? walk_to_motor(s, p, c / *x, false)
+                              : walk_to_motor(s, p, 0.0, true);
+  return 1.0 / (p.inertia[0] * s + p.bv + 4.0 * p.mm / (kPi * vm) + e.force / e.velocity);
 }
 
 /// Load encoder: explicit. The load's describing function cl = 4Ml/(π|Vl|) comes from the
-/// measured |Vl|; the load's balance (Jl s + cl)Vl = Z(Vm − Vl) gives H = Vm/Vl = 1 + (Jl s + cl)/Z,
-/// hence |Vm| = |H||Vl| and the motor's cm = 4Mm/(π|Vm|); the motor's balance
-/// L·T = (Jm s + bv + cm)Vm + Z(Vm − Vl) then gives P = Vl/T = L/((Jm s + bv + cm)H + Jl s + cl).
+/// measured |Vl|; the walk gives Vm/Vl and with it |Vm| and the motor's cm = 4Mm/(π|Vm|); the
+/// motor's balance L·T = (J1 s + bv + cm)Vm + F1 then gives P = Vl/T.
 Complex load_side(double omega, double vl, const ChainParameters& p) {
-  const Complex s(0.0, omega), z(p.bs, -p.k / omega);
-  const double cl = 4.0 * p.ml / (kPi * vl);
-  const Complex h = 1.0 + (p.jl * s + cl) / z;
-  const double cm = 4.0 * p.mm / (kPi * std::abs(h) * vl);
-  return 1.0 / ((p.jm * s + p.bv + cm) * h + p.jl * s + cl);
+  const Complex s(0.0, omega);
+  const MotorEnd e = walk_to_motor(s, p, 4.0 * p.ml / (kPi * vl), false);
+  const double cm = 4.0 * p.mm / (kPi * std::abs(e.velocity) * vl);
+  return 1.0 / ((p.inertia[0] * s + p.bv + cm) * e.velocity + e.force);
+}
+
+/// The linear chain's polynomials: the walk with cl = 0 in s, multiplied through by the shafts'
+/// (bi s + ki)/s. Vm/Vl = U/Q, F1/Vl = F/Q with Q = Π(bi s + ki): the motor-side admittance is
+/// U/((J1 s + bv)U + F), the load side's Q/((J1 s + bv)U + F).
+struct ChainPolynomials {
+  core::Polynomial u, f, q;
+};
+
+ChainPolynomials chain_polynomials(const ChainParameters& p) {
+  const std::size_t n = p.shafts();
+  const core::Polynomial s{1.0, 0.0};
+  ChainPolynomials c{core::Polynomial{1.0}, core::Polynomial{p.inertia[n], 0.0}, core::Polynomial{1.0}};
+  for (std::size_t i = n; i-- > 0;) {
+    const core::Polynomial shaft{p.damping[i], p.stiffness[i]};
+    c.u = c.u * shaft + c.f * s;
+    c.q = c.q * shaft;
+    if (i == 0) {
+      c.f = c.f * shaft;
+      break;
+    }
+    c.f = c.f * shaft + p.inertia[i] * (s * c.u);
+  }
+  return c;
+}
+
+/// Complex roots as modal pairs; real roots paired in ascending order (an overdamped pair:
+/// ω² = their product, 2ζω = −their sum). Ascending frequency.
+std::vector<ModalPair> modal_pairs(const std::vector<Complex>& roots) {
+  std::vector<ModalPair> pairs;
+  std::vector<double> real;
+  for (const Complex& r : roots) {
+    if (r.imag() > 0.0) pairs.push_back({std::abs(r), -r.real() / std::abs(r)});
+    if (r.imag() == 0.0) real.push_back(r.real());
+  }
+  std::sort(real.begin(), real.end(), [](double a, double b) { return std::abs(a) < std::abs(b); });
+  for (std::size_t i = 0; i + 1 < real.size(); i += 2) {
+    const double omega = std::sqrt(real[i] * real[i + 1]);
+    pairs.push_back({omega, -(real[i] + real[i + 1]) / (2.0 * omega)});
+  }
+  std::sort(pairs.begin(), pairs.end(), [](const ModalPair& a, const ModalPair& b) { return a.omega_rad_s < b.omega_rad_s; });
+  return pairs;
+}
+
+/// Polynomial in s² with the given roots −ω², times s when `odd`, coefficients highest first with
+/// the odd (even) powers' zeros explicit: the parity the continued fraction relies on.
+std::vector<double> even_polynomial(const std::vector<double>& omega, bool odd) {
+  std::vector<double> c{1.0};
+  for (double w : omega) {
+    std::vector<double> next(c.size() + 2, 0.0);
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      next[i] += c[i];
+      next[i + 2] += c[i] * w * w;
+    }
+    c = std::move(next);
+  }
+  if (odd) c.push_back(0.0);
+  return c;
 }
 
 }  // namespace
+
+double ChainParameters::total_inertia() const noexcept { return std::accumulate(inertia.begin(), inertia.end(), 0.0); }
+
+ChainParameters two_mass_chain(double jm, double jl, double k, double bs, double bv, double mm, double ml) {
+  return {{jm, jl}, {k}, {bs}, bv, mm, ml};
+}
 
 std::complex<double> chain_response(double omega, double velocity_amplitude, const ChainParameters& p,
                                     const PlantModel& actuator, SensorSide sensor) {
@@ -82,25 +173,62 @@ PlantModel chain_linear_part(const ChainParameters& p, const PlantModel& actuato
   m.lag_pole_rad_s = actuator.lag_pole_rad_s;
   m.delay_s = actuator.delay_s;
   const double lag = actuator.lag_pole_rad_s ? *actuator.lag_pole_rad_s : 1.0;
-  m.gain = lag / (sensor == SensorSide::kMotor ? p.jm : p.jm + p.jl);
-  // Monic cubic s³ + c2 s² + c1 s + c0 over Jm Jl.
-  const double jj = p.jm * p.jl;
-  const core::Polynomial den{1.0, ((p.jm + p.jl) * p.bs + p.bv * p.jl) / jj, ((p.jm + p.jl) * p.k + p.bv * p.bs) / jj,
-                             p.bv * p.k / jj};
-  // The rigid pole is the real root nearest 0 (exactly 0 when bv = 0); the other two, a complex
-  // pair or (overdamped) two real roots, form the resonance: ω² = their product, 2ζω = −their sum.
+  m.gain = lag / (sensor == SensorSide::kMotor ? p.inertia[0] : p.total_inertia());
+  const ChainPolynomials c = chain_polynomials(p);
+  const core::Polynomial den = core::Polynomial{p.inertia[0], p.bv} * c.u + c.f;
+  // The rigid pole is the real root nearest 0 (exactly 0 when bv = 0); the rest form the modes.
   std::vector<Complex> roots = den.roots();
   std::sort(roots.begin(), roots.end(), [](Complex x, Complex y) { return std::abs(x) < std::abs(y); });
-  if (roots[0].imag() != 0.0) std::swap(roots[0], roots[2]);  // a pair below the real root: keep the real one rigid
-  const double omega_n = std::sqrt((roots[1] * roots[2]).real());
-  const double zeta_n = -(roots[1] + roots[2]).real() / (2.0 * omega_n);
+  const auto rigid_root = std::find_if(roots.begin(), roots.end(), [](Complex x) { return x.imag() == 0.0; });
+  const double rigid_pole = rigid_root != roots.end() ? -rigid_root->real() : 0.0;
+  if (rigid_root != roots.end()) roots.erase(rigid_root);
   m.rigid = rigid == RigidKind::kIntegrator || p.bv == 0.0 ? RigidKind::kIntegrator : RigidKind::kRealPole;
-  m.rigid_pole_rad_s = m.rigid == RigidKind::kRealPole ? -roots[0].real() : 0.0;
-  const ModalPair zeros = sensor == SensorSide::kMotor
-                              ? ModalPair{std::sqrt(p.k / p.jl), p.bs / (2.0 * std::sqrt(p.k * p.jl))}
-                              : ModalPair{};
-  m.modes = {{zeros, {omega_n, zeta_n}}};
+  m.rigid_pole_rad_s = m.rigid == RigidKind::kRealPole ? rigid_pole : 0.0;
+  const std::vector<ModalPair> poles = modal_pairs(roots);
+  const std::vector<ModalPair> zeros = sensor == SensorSide::kMotor ? modal_pairs(c.u.roots()) : std::vector<ModalPair>{};
+  for (std::size_t i = 0; i < poles.size(); ++i) m.modes.push_back({i < zeros.size() ? zeros[i] : ModalPair{}, poles[i]});
   return m;
+}
+
+std::optional<ChainParameters> chain_of_modes(const std::vector<Mode>& modes, double gain, std::string& why) {
+  if (modes.empty() || !(gain > 0.0)) {
+    why = "no flexible mode or no positive gain";
+    return std::nullopt;
+  }
+  // Frequencies in units of the first antiresonance keep the coefficients near one.
+  const double unit = modes.front().antiresonance.omega_rad_s;
+  std::vector<double> wz, wp;
+  for (const Mode& m : modes) {
+    wz.push_back(m.antiresonance.omega_rad_s / unit);
+    wp.push_back(m.resonance.omega_rad_s / unit);
+  }
+  // Z(s) = (unit/K)·s̃Π(s̃² + ω̃p²)/Π(s̃² + ω̃z²) with s = unit·s̃: each step takes the leading
+  // term e·s̃ of num/den (an inertia J = e/unit in an impedance step, a compliance 1/k = e/unit in
+  // an admittance step) and continues with den/(num − e·s̃·den), whose two leading coefficients
+  // vanish (the first by construction, the second by parity).
+  std::vector<double> num = even_polynomial(wp, true), den = even_polynomial(wz, false);
+  for (double& x : num) x *= unit / gain;
+  const std::size_t n = modes.size();
+  ChainParameters chain;
+  for (std::size_t step = 0; step <= 2 * n; ++step) {
+    const double e = num.front() / den.front();
+    if (!(e > 0.0) || !std::isfinite(e)) {
+      why = "the modes do not interlace as a mass chain's (its element " + std::to_string(step + 1) + " is not positive)";
+      return std::nullopt;
+    }
+    if (step % 2 == 0)
+      chain.inertia.push_back(e / unit);
+    else
+      chain.stiffness.push_back(unit / e);
+    if (step == 2 * n) break;
+    std::vector<double> rest(den.size() - 1);
+    for (std::size_t i = 0; i < rest.size(); ++i) rest[i] = num[i + 2] - (i + 2 < den.size() ? e * den[i + 2] : 0.0);
+    num = std::move(den);
+    den = std::move(rest);
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    chain.damping.push_back(2.0 * modes[i].resonance.zeta * chain.stiffness[i] / modes[i].resonance.omega_rad_s);
+  return chain;
 }
 
 }  // namespace servotwin::fit::detail

@@ -49,4 +49,16 @@ MisfitScale misfit_scale(const Eigen::VectorXd& r, double dof, bool known_std) {
                              std::sqrt(kappa), rho)};
 }
 
+Estimate log_estimate(const Eigen::VectorXd& t, const Eigen::MatrixXd& c, Eigen::Index i, double sign) {
+  const double v = sign * std::exp(t[i]);
+  return {v, std::abs(v) * std::sqrt(std::max(0.0, c(i, i)))};
+}
+
+bool better_run(const core::LmResult& run, const core::LmResult& best) {
+  if (run.status == core::LmStatus::kInvalidStart) return false;
+  if (!std::isfinite(best.cost)) return true;
+  if (run.converged() != best.converged()) return run.converged();
+  return run.cost < best.cost;
+}
+
 }  // namespace servotwin::fit::detail

@@ -8,6 +8,8 @@
 #include <string>
 
 #include "servotwin/core/frequency_response.hpp"
+#include "servotwin/core/levenberg_marquardt.hpp"
+#include "servotwin/fit/fit.hpp"
 
 namespace servotwin::fit::detail {
 
@@ -30,5 +32,14 @@ struct MisfitScale {
   std::string note;
 };
 MisfitScale misfit_scale(const Eigen::VectorXd& r, double dof, bool known_std);
+
+/// A positive parameter fitted by its logarithm θi: sign·exp(θi) and its std by the delta method,
+/// |value|·sqrt(c_ii).
+Estimate log_estimate(const Eigen::VectorXd& t, const Eigen::MatrixXd& c, Eigen::Index i, double sign = 1.0);
+
+/// Which of two LM runs from different starts to keep: a converged run beats one that is not,
+/// then the lower cost wins; a run that could not start never wins (`best` may be a
+/// default-constructed result with infinite cost, meaning none yet).
+bool better_run(const core::LmResult& run, const core::LmResult& best);
 
 }  // namespace servotwin::fit::detail

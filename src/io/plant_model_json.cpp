@@ -76,7 +76,17 @@ json nonlinear_json(const fit::NonlinearMechanics& n) {
 }
 
 json friction_json(const fit::CoulombFit& c) {
-  return {{"model", "two-mass, Coulomb on motor and load"},
+  const auto values = [](const std::vector<fit::Estimate>& v) {
+    json a = json::array();
+    for (const fit::Estimate& e : v) a.push_back(e.value);
+    return a;
+  };
+  const std::size_t masses = c.inertias.size();
+  return {{"model", masses <= 2 ? std::string("two-mass, Coulomb on motor and load")
+                                : std::to_string(masses) + "-mass chain, Coulomb on motor and load"},
+          {"inertias", values(c.inertias)},
+          {"stiffnesses", values(c.stiffnesses)},
+          {"shaft_dampings", values(c.shaft_dampings)},
           {"motor_coulomb", c.motor_coulomb.value},
           {"motor_coulomb_std", number_or_null(c.motor_coulomb.std)},
           {"load_coulomb", c.load_coulomb.value},

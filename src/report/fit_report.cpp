@@ -182,15 +182,15 @@ Section nonlinear_section(const fit::NonlinearMechanics& n) {
 Section friction_section(const fit::CoulombFit& f) {
   Section s;
   s.title = "Coulomb friction";
-  s.text = "The two-mass model with Coulomb friction on motor and load, fitted at each point's measured amplitude "
+  s.text = "The mass-chain model with Coulomb friction on motor and load, fitted at each point's measured amplitude "
            "(describing functions 4M/(pi V), harmonic balance). Its linear part (viscous damping only) is the model "
            "above and the one written: " + f.note + ".";
   s.tables.push_back(value_table("Friction and residuals", "quantity",
                                  {{"motor Coulomb friction Mm (input units)", with_std(f.motor_coulomb)},
                                   {"load Coulomb friction Ml (input units)", with_std(f.load_coulomb)},
                                   {"motor viscous damping bv", with_std(f.viscous_damping)},
-                                  {"total inertia Jm + Jl", with_std(f.total_inertia)},
-                                  {"motor's share Jm/(Jm + Jl)", with_std(f.motor_share)},
+                                  {"total inertia", with_std(f.total_inertia)},
+                                  {"motor's share of the inertia", with_std(f.motor_share)},
                                   {"rms |ln(P_model/P_meas)| with friction", num(f.rms_log_error, 4)},
                                   {"rms |ln(P_model/P_meas)| of the linear fit", num(f.linear_rms_log_error, 4)}}));
   return s;

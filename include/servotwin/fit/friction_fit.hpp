@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Coulomb friction fitted with the two-mass model from one swept-sine measurement (issue 25 §1).
+/// Coulomb friction fitted with a mass-chain model from one swept-sine measurement (issue 25 §1).
 ///
 /// Friction comparable to the excitation torque distorts a swept-sine response in two ways a linear
 /// model can only absorb wrongly: below the antiresonance the motor-side describing function
@@ -11,17 +11,23 @@
 /// (FrequencyPoint::amplitude), so the motor's velocity amplitude is |P|·T (ω|P|·T for a position
 /// output).
 ///
-/// The model (dissertation C3.12's two-mass with C5.10's describing functions, harmonic balance
-/// at each point): motor inertia Jm with viscous damping bv and Coulomb level Mm, shaft stiffness k
-/// and damping bs, load inertia Jl with Coulomb level Ml, driven through the linear fit's lag
-/// p/(s + p) and delay. With the shaft impedance Z = bs + k/s and the load's describing function
-/// cl = 4Ml/(π|Vl|), the load follows Vl = G·Vm, G = Z/(Jl s + cl + Z); |Vl| = |G||Vm| is then a
-/// quadratic in |Vl| with a closed-form root (none when |Vm||Z| ≤ 4Ml/π: the load sticks, G = 0).
-/// The motor's describing function uses the measured |Vm|, so each point's model response is
+/// The model (dissertation C3.12's two-mass, and its mass chain, with C5.10's describing functions,
+/// harmonic balance at each point): the motor J1 with viscous damping bv and Coulomb level Mm,
+/// shafts of stiffness ki and damping bi, inner masses without friction, the load (the last mass)
+/// with Coulomb level Ml, driven through the linear fit's lag p/(s + p) and delay. With the load's
+/// describing function cl = 4Ml/(π|Vl|), walking the chain from the load (each shaft's force over
+/// its impedance bi + ki/s moves the next mass inward) gives the motor's velocity and the first
+/// shaft's force per unit load velocity, Vm/Vl = A + B·cl and F1/Vl, both affine in cl; |Vm| =
+/// |Vl||A + B·cl| is then a quadratic in |Vl| with a closed-form root (none when |Vm| ≤ |B|·4Ml/π:
+/// the load sticks and the walk starts from a held load). The motor's describing function uses
+/// the measured |Vm|, so each point's model response is
 ///
-///   P = L(s) / (Jm s + bv + 4Mm/(π|Vm|) + Z (1 − G)),
+///   P = L(s) / (J1 s + bv + 4Mm/(π|Vm|) + F1/Vm),
 ///
-/// explicit in the parameters. Seen from a load encoder (a load-side linear fit,
+/// explicit in the parameters (for two masses F1/Vm = Z(1 − G), Z = bs + k/s, G = Z/(Jl s + cl + Z)).
+/// A motor-side linear fit of n modes starts the chain of n + 1 masses: its undamped modes give
+/// the inertias and stiffnesses by Cauer's continued fraction (the two-mass parameters for one
+/// mode). Seen from a load encoder (a one-mode load-side linear fit,
 /// SensorSide::kLoad) the balance is explicit too: the load's describing function cl = 4Ml/(π|Vl|)
 /// comes from the measured |Vl|, the load's balance gives Vm/Vl = H = 1 + (Jl s + cl)/Z and with it
 /// |Vm| and the motor's describing function, and P = L/((Jm s + bv + 4Mm/(π|Vm|))H + Jl s + cl).
@@ -30,8 +36,9 @@
 /// on different velocities. The share Jm/J is fitted from 1/2 and, when the friction is too small
 /// to tell it (a singular Jacobian), held where LM left it (its std NaN) and said so in the note;
 /// short of that its std tells how well it is seen. (With the motor's viscous damping bv the
-/// linear part sees the split too, weakly.)
-/// Levenberg–Marquardt fits (ln Jm, ln Jl, ln k, ln bs, bv, Mm, Ml, and
+/// linear part sees the split too, weakly.) A load-side chain of more masses is not fitted: its
+/// linear part gives n + 1 numbers for 2n + 1 inertias and stiffnesses.
+/// Levenberg–Marquardt fits (ln Ji, ln ki, ln bi, bv, Mm, Ml, and
 /// the lag pole and delay when the linear fit has them: friction bends its phase, and with it the
 /// lag) to the complex log errors of the points the linear fit used (its left-out points stay out),
 /// weighted as the linear fit weights them (fit.hpp), from the linear fit's physical parameters:
@@ -44,6 +51,7 @@
 #include <complex>
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "servotwin/core/frequency_response.hpp"
 #include "servotwin/fit/fit.hpp"
@@ -51,7 +59,7 @@
 
 namespace servotwin::fit {
 
-/// The two-mass model with Coulomb friction on both masses, and its linear part.
+/// The mass-chain model with Coulomb friction on motor and load, and its linear part.
 struct CoulombFit {
   bool fitted = false;
   std::string note;                    ///< how it was fitted, or why not
@@ -60,14 +68,19 @@ struct CoulombFit {
   PlantModel model;
   Estimate gain;                       ///< the linear part's K = p/Jm (1/Jm without a lag)
   Estimate motor_coulomb, load_coulomb;  ///< Mm, Ml in the input's units (torque, force, current)
-  Estimate motor_inertia, load_inertia, stiffness, shaft_damping, viscous_damping;
+  Estimate motor_inertia, load_inertia;  ///< the first and the last mass
+  Estimate stiffness, shaft_damping;    ///< the shaft of a two-mass chain (NaN for a longer chain)
+  std::vector<Estimate> inertias;      ///< every mass, motor first
+  std::vector<Estimate> stiffnesses, shaft_dampings;  ///< every shaft, from the motor
+  Estimate viscous_damping;
   Estimate total_inertia;              ///< Jm + Jl (its std from the fit on the load side only)
   Estimate motor_share;                ///< Jm/(Jm + Jl) (its std from the fit on the load side only)
   Estimate rigid_pole_rad_s;           ///< bv's pole of the linear part (0 for an integrator)
-  Estimate resonance_ratio;            ///< r = ωn/ωz of the linear part
+  Estimate resonance_ratio;            ///< r = ωn/ωz of a two-mass linear part (NaN otherwise)
   Estimate lag_pole_rad_s, delay_s;    ///< refitted with the friction (NaN when the linear fit has none)
-  ModeUncertainty mode;                ///< antiresonance (NaN on the load side) and resonance of the linear part
-  /// θ = (ln Jm, ln Jl, ln k, ln bs, bv, Mm, Ml[, ln p][, T]) (scaled; on the load side
+  /// Each mode's antiresonance (NaN on the load side) and resonance of the linear part.
+  std::vector<ModeUncertainty> modes;
+  /// θ = (ln J1…ln Jn+1, ln k1…ln kn, ln b1…ln bn, bv, Mm, Ml[, ln p][, T]) (scaled; on the load side
   /// (ln J, logit Jm/J, ln k̃, ln b̃s, ...) with k = 4s(1 − s)k̃, bs = 4s(1 − s)b̃s) at the solution and
   /// its covariance (the linear fit's rule; the rows and columns of a held bv or share are zero).
   Eigen::VectorXd theta;
@@ -84,11 +97,12 @@ struct CoulombFit {
   std::string message;                 ///< LM stopping reason
 };
 
-/// Fits the two-mass model with Coulomb friction to `response` (the points `linear` used: valid and
-/// not in linear.left_out_hz), starting from `linear` (a two-mass fit of the same response with
-/// physical parameters, or a one-mode load-side fit; the side is linear's). Returns fitted = false
-/// with the reason when the linear fit has no two-mass reading, the points carry no excitation
-/// amplitude, or LM does not converge. `options.rigid == kIntegrator` fixes bv = 0.
+/// Fits the mass chain with Coulomb friction to `response` (the points `linear` used: valid and
+/// not in linear.left_out_hz), starting from `linear` (a motor-side fit of n modes: a chain of
+/// n + 1 masses; or a one-mode load-side fit; the side is linear's). Returns fitted = false with the
+/// reason when the linear fit has no chain reading (no two-mass parameters, modes that do not
+/// interlace, a load-side fit of several modes), the points carry no excitation amplitude, or LM
+/// does not converge. `options.rigid == kIntegrator` fixes bv = 0.
 CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const FitReport& linear, const FitOptions& options);
 
 /// `linear` with its result replaced by the friction fit's linear part (model, estimates, physical
@@ -113,5 +127,14 @@ std::complex<double> coulomb_two_mass_response(double omega_rad_s, double motor_
 std::complex<double> coulomb_two_mass_load_response(double omega_rad_s, double load_velocity_amplitude, double jm, double jl,
                                                     double k, double bs, double bv, double mm, double ml,
                                                     const PlantModel& linear_model);
+
+/// The mass chain of `inertias.size()` masses (motor first; `stiffnesses` and `dampings` one per
+/// shaft from the motor) with Coulomb friction `mm` on the motor and `ml` on the load (the last
+/// mass), seen from `sensor`'s encoder at a point whose measured velocity amplitude on that side is
+/// `velocity_amplitude` (exposed for tests; the two-mass functions above are its one-shaft case).
+std::complex<double> coulomb_chain_response(double omega_rad_s, double velocity_amplitude, const std::vector<double>& inertias,
+                                            const std::vector<double>& stiffnesses, const std::vector<double>& dampings,
+                                            double bv, double mm, double ml, const PlantModel& linear_model,
+                                            SensorSide sensor);
 
 }  // namespace servotwin::fit
