@@ -22,6 +22,9 @@ std::string fmt_reason(fmt::format_string<Args...> format, Args&&... args) {
 }
 constexpr long kHoldoffPeriods = 2;     // observer re-convergence after a start or a frequency jump (~1.25 periods)
 constexpr double kMinimumAmplitudeFraction = 0.05;  // range reduction floor, relative to A(0)
+/// The longest window of the settling test on half-period means (settle_windows.hpp): long enough
+/// to average the beat of a mode ringing a few hertz away, short against the 2 s a point may take.
+constexpr double kMaxWindow_s = 0.25;
 constexpr double kSettleNoiseFraction = 0.25;  // share of the sensor noise (in output units) a settled estimate may still move per half period
 
 [[noreturn]] void reject(const std::string& field, const std::string& expected, double got) {
@@ -194,6 +197,11 @@ void RfidBlock::enter_settle() noexcept {
   period_length_ = std::max(1L, period_samples(omega_) / 2);
   period_converged_ = false;
   period_mark_ = {};
+  windows_.clear();
+  window_converged_ = false;
+  max_window_ = static_cast<std::size_t>(std::clamp(std::floor(kMaxWindow_s / (static_cast<double>(period_length_) * p_.ts)), 0.0,
+                                                    static_cast<double>(SettleWindows::kCapacity / 2)));
+  settle_limit_ = max_settle_limit();
 }
 
 double RfidBlock::idle_command(double cv) const noexcept {
@@ -290,7 +298,10 @@ void RfidBlock::advance_settle(std::complex<double> running, double thd) noexcep
     period_count_ = 0;
     period_converged_ = false;
     period_mark_ = running;
+    windows_.clear();
+    window_converged_ = false;
   }
+  windows_.add(running);
   if (++period_count_ >= period_length_) {
     // With a known sensor noise, changes the noise alone explains count as settled: near an
     // antiresonance the response is small and a purely relative test would wait for nothing.
@@ -300,11 +311,17 @@ void RfidBlock::advance_settle(std::complex<double> running, double thd) noexcep
         std::abs(running - period_mark_) <= 0.5 * p_.settle_tolerance * std::abs(running) + noise_allowance;
     period_mark_ = running;
     period_count_ = 0;
+    windows_.close_half_period();
+    const SettleWindows::Verdict w = windows_.test(0.5 * p_.settle_tolerance, noise_allowance, max_window_);
+    window_converged_ = w.settled;
+    window_mean_ = w.mean;
   }
   const bool thd_accepted = !adapter_.relay() || adapter_.blocked();
   const bool faded_in = fade_done_ >= fade_length_;
-  if (settle_elapsed_ >= settle_samples_ && period_converged_ && thd_accepted && faded_in) latch(running, thd, true);
-  else if (settle_total_ >= max_settle_limit()) latch(running, thd, false);
+  const bool ready = settle_elapsed_ >= settle_samples_ && thd_accepted && faded_in;
+  if (ready && period_converged_) latch(running, thd, true);
+  else if (ready && window_converged_) latch(window_mean_, thd, true);
+  else if (settle_total_ >= settle_limit_) latch(windows_.longest_mean(max_window_, running), thd, false);
 }
 
 void RfidBlock::latch(std::complex<double> running, double thd, bool settled) noexcept {

@@ -30,6 +30,7 @@
 #include "servotwin/frf/excitation.hpp"
 #include "servotwin/frf/harmonic_observer.hpp"
 #include "servotwin/frf/observer_gains.hpp"
+#include "servotwin/frf/settle_windows.hpp"
 
 namespace servotwin::frf {
 
@@ -160,7 +161,7 @@ class RfidBlock {
   double idle_command(double cv) const noexcept;
   [[nodiscard]] long period_samples(double omega) const noexcept;
   /// The settling limit at the current frequency: max_settling_time_s, or max_settling_periods
-  /// periods when that is shorter.
+  /// periods when that is shorter (computed on entering a point: settle_limit_).
   [[nodiscard]] long max_settle_limit() const noexcept;
   double fade_in_factor() noexcept;
 
@@ -183,6 +184,11 @@ class RfidBlock {
   long settle_elapsed_ = 0, settle_total_ = 0, period_count_ = 0, period_length_ = 1;
   std::complex<double> period_mark_;
   bool period_converged_ = false;
+  SettleWindows windows_;              ///< half-period means since the last change (settle_windows.hpp)
+  std::size_t max_window_ = 0;         ///< the longest window in half periods at this frequency
+  long settle_limit_ = 0;              ///< max_settle_limit() at this frequency
+  bool window_converged_ = false;
+  std::complex<double> window_mean_;
   PointKind settle_kind_ = PointKind::kListed;
   double resume_omega_ = 0.0;
   std::size_t extra_points_ = 0;

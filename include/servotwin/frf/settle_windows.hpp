@@ -1,0 +1,64 @@
+#pragma once
+/// \file
+/// The settling test on windows of half-period means, beside RfidBlock's test on single estimates
+/// half a period apart (issue 25 §1's 30 s, and points that are steady but noisy or still ring).
+///
+/// The single test compares the running estimate P̂ with its value half a period earlier. Two kinds
+/// of points defeat it: a point whose response is small against the sensor noise (the half-period
+/// change stays several times the allowance although P is steady: it waits for a lucky pair or for
+/// its time limit), and a point beside a lightly damped mode, whose estimate carries the mode's
+/// ringing as a slow beat (the change is small at the beat's turning points, so it may pass by
+/// chance with the ringing still in). Means over W half periods average the noise by √W and the
+/// beat over its period; comparing the means of the last two windows, and requiring the last
+/// window's standard error (the spread of its half-period means over √W) to be within twice the
+/// same bound, tells a steady point from one still ringing. W = 2, 4, 8, … up to a time span
+/// (RfidBlock uses 0.25 s, so the test acts above 4 Hz and leaves the long low-frequency periods to
+/// the single test).
+///
+/// Fixed storage: no allocation per sample (a real-time block's member).
+
+#include <array>
+#include <complex>
+#include <cstddef>
+
+namespace servotwin::frf {
+
+class SettleWindows {
+ public:
+  /// Half-period means kept; the longest window is half of it.
+  static constexpr std::size_t kCapacity = 512;
+
+  /// Forgets everything (a new frequency or a changed amplitude: a new transient).
+  void clear() noexcept;
+  /// One sample of the running estimate.
+  void add(std::complex<double> running) noexcept;
+  /// Ends the current half period: its mean becomes the newest stored one.
+  void close_half_period() noexcept;
+  /// Half-period means stored since the last clear (at most kCapacity).
+  [[nodiscard]] std::size_t count() const noexcept;
+
+  struct Verdict {
+    bool settled = false;
+    std::complex<double> mean;  ///< the passing window's mean (valid when settled)
+  };
+  /// The shortest window W ∈ {2, 4, 8, …} (W ≤ max_window, 2W means stored) whose mean differs
+  /// from the previous W means' by at most relative·|mean| + absolute, its standard error within
+  /// twice that.
+  [[nodiscard]] Verdict test(double relative, double absolute, std::size_t max_window) const noexcept;
+  /// The mean of the longest window W ∈ {2, 4, …} ≤ max_window that is stored; `fallback` when
+  /// fewer than two means are.
+  [[nodiscard]] std::complex<double> longest_mean(std::size_t max_window, std::complex<double> fallback) const noexcept;
+
+ private:
+  /// The k-th newest stored mean (k = 0 the newest).
+  [[nodiscard]] std::complex<double> newest(std::size_t k) const noexcept;
+  /// Mean of the stored means k ∈ [first, first + w).
+  [[nodiscard]] std::complex<double> window_mean(std::size_t first, std::size_t w) const noexcept;
+
+  std::array<std::complex<double>, kCapacity> means_{};
+  std::size_t pushed_ = 0;  ///< means stored since the last clear (may exceed kCapacity: a ring)
+  std::complex<double> sum_;
+  long samples_ = 0;
+};
+
+}  // namespace servotwin::frf
