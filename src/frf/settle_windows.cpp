@@ -18,7 +18,9 @@ void SettleWindows::add(std::complex<double> running) noexcept {
 
 void SettleWindows::close_half_period() noexcept {
   if (samples_ == 0) return;
-  means_[pushed_ % kCapacity] = sum_ / static_cast<double>(samples_);
+  const std::complex<double> mean = sum_ / static_cast<double>(samples_);
+  const Totals previous = totals_through(0);
+  totals_[pushed_ % totals_.size()] = {previous.sum + mean, previous.norm + std::norm(mean)};
   ++pushed_;
   sum_ = {};
   samples_ = 0;
@@ -26,23 +28,26 @@ void SettleWindows::close_half_period() noexcept {
 
 std::size_t SettleWindows::count() const noexcept { return std::min(pushed_, kCapacity); }
 
-std::complex<double> SettleWindows::newest(std::size_t k) const noexcept { return means_[(pushed_ - 1 - k) % kCapacity]; }
+SettleWindows::Totals SettleWindows::totals_through(std::size_t k) const noexcept {
+  return k >= pushed_ ? Totals{} : totals_[(pushed_ - 1 - k) % totals_.size()];
+}
 
-std::complex<double> SettleWindows::window_mean(std::size_t first, std::size_t w) const noexcept {
-  std::complex<double> s;
-  for (std::size_t k = first; k < first + w; ++k) s += newest(k);
-  return s / static_cast<double>(w);
+SettleWindows::Totals SettleWindows::window(std::size_t first, std::size_t w) const noexcept {
+  const Totals to = totals_through(first), from = totals_through(first + w);
+  return {to.sum - from.sum, to.norm - from.norm};
 }
 
 SettleWindows::Verdict SettleWindows::test(double relative, double absolute, std::size_t max_window) const noexcept {
   const std::size_t stored = count();
   for (std::size_t w = 2; w <= max_window && 2 * w <= stored; w *= 2) {
-    const std::complex<double> last = window_mean(0, w), previous = window_mean(w, w);
+    const Totals last_window = window(0, w);
+    const double n = static_cast<double>(w);
+    const std::complex<double> last = last_window.sum / n, previous = window(w, w).sum / n;
     const double bound = relative * std::abs(last) + absolute;
     if (std::abs(last - previous) > bound) continue;
-    double spread = 0.0;
-    for (std::size_t k = 0; k < w; ++k) spread += std::norm(newest(k) - last);
-    const double standard_error = std::sqrt(spread / static_cast<double>(w - 1) / static_cast<double>(w));
+    // Σ|m − mean|² = Σ|m|² − w|mean|²: the running totals' difference, floored at 0 (rounding).
+    const double spread = std::max(0.0, last_window.norm - n * std::norm(last));
+    const double standard_error = std::sqrt(spread / (n - 1.0) / n);
     if (standard_error <= 2.0 * bound) return {true, last};
   }
   return {};
@@ -51,7 +56,7 @@ SettleWindows::Verdict SettleWindows::test(double relative, double absolute, std
 std::complex<double> SettleWindows::longest_mean(std::size_t max_window, std::complex<double> fallback) const noexcept {
   std::size_t w = 0;
   for (std::size_t next = 2; next <= max_window && next <= count(); next *= 2) w = next;
-  return w == 0 ? fallback : window_mean(0, w);
+  return w == 0 ? fallback : window(0, w).sum / static_cast<double>(w);
 }
 
 }  // namespace servotwin::frf

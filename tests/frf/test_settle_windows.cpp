@@ -83,16 +83,26 @@ TEST(SettleWindows, WindowsNeverExceedTheirLimitOrTheStoredMeans) {
 }
 
 TEST(SettleWindows, TheRingKeepsTheNewestMeans) {
-  // More half periods than the capacity: the windows read the newest (all equal to 7 after a
-  // first batch of zeros that has been overwritten).
+  // More half periods than the capacity, the count not a multiple of it, each mean its own index
+  // k: a window of the newest w has the mean of the w largest indices, (2N + 36 − 1) − (w − 1)/2,
+  // and the previous window's is w lower; the longest window (the capacity) reaches the oldest
+  // kept mean.
+  constexpr std::size_t n = SettleWindows::kCapacity, pushed = 2 * n + 36;
   SettleWindows w;
-  for (std::size_t k = 0; k < SettleWindows::kCapacity; ++k) half_period(w, 0.0, 1);
-  for (std::size_t k = 0; k < SettleWindows::kCapacity; ++k) half_period(w, 7.0, 1);
-  EXPECT_EQ(w.count(), SettleWindows::kCapacity);
-  EXPECT_EQ(w.longest_mean(SettleWindows::kCapacity, 0.0), Complex(7.0, 0.0));
-  const SettleWindows::Verdict v = w.test(0.0, 1e-12, SettleWindows::kCapacity / 2);
+  for (std::size_t k = 0; k < pushed; ++k) half_period(w, Complex(static_cast<double>(k), 1.0), 1);
+  EXPECT_EQ(w.count(), n);
+  for (std::size_t window : {2u, 8u, 64u, 256u}) {
+    const double newest = static_cast<double>(pushed - 1);
+    EXPECT_NEAR(w.longest_mean(window, 0.0).real(), newest - (static_cast<double>(window) - 1.0) / 2.0, 1e-9) << window;
+    EXPECT_NEAR(w.longest_mean(window, 0.0).imag(), 1.0, 1e-12) << window;
+  }
+  EXPECT_NEAR(w.longest_mean(n, 0.0).real(), static_cast<double>(pushed - 1) - (static_cast<double>(n) - 1.0) / 2.0, 1e-9);
+  // Consecutive windows of w differ by w. Absolute bound 3: w = 2 passes (|Δ| = 2; its two means
+  // k − 1, k have standard error 0.5 ≤ 6) with mean k − 1/2; bound 1.5: no window passes.
+  const SettleWindows::Verdict v = w.test(0.0, 3.0, 128);
   ASSERT_TRUE(v.settled);
-  EXPECT_EQ(v.mean, Complex(7.0, 0.0));
+  EXPECT_NEAR(v.mean.real(), static_cast<double>(pushed - 1) - 0.5, 1e-9);  // w = 2: |Δ| = 2 ≤ 3
+  EXPECT_FALSE(w.test(0.0, 1.5, 128).settled);                               // every |Δ| = w ≥ 2
 }
 
 }  // namespace settle_windows_test

@@ -277,12 +277,14 @@ machine::PlantConfig three_mass_with_coulomb(double level) {
 
 // Issue 25 §1 on the three-mass chain, friction 0.5 and 3 times the start amplitude: the fit with
 // Coulomb friction (a chain of three masses from the two-mode linear fit) gives the four
-// frequencies within 0.5 % and the chain's inertias and stiffnesses within 2 %, where the linear
-// fit puts the first antiresonance's damping 6–10 times too high. Reference: the chain's own
+// frequencies within 0.5 %, their dampings within 20 % and the chain's inertias and stiffnesses
+// within 2 %, and no rigid pole, where the linear fit puts the first antiresonance's damping 6–10
+// times too high and reads the friction as a rigid pole of 0.6 Hz. Reference: the chain's own
 // parameters, its modes from tools/reference/mass_chain_modes.py (38.093/68.654 and
-// 271.469/319.524 Hz, ζz1 0.00270). The dampings of these light modes come within 20–50 % (the
-// study's table); the experiment takes 31–34 s (34–38 s before the settling test on windows of
-// half-period means): this test guards 35 s, not §1's 30.
+// 271.469/319.524 Hz, ζ 0.00270/0.00512 and 0.00890/0.00928). Measured: dampings +1/+10/−1/−2 %
+// and +3/+16/−4/−5 %, rigid pole 0.027 ± 0.032 and 0.040 ± 0.042 Hz. The experiment takes 32–33 s
+// (34–38 s before the settling test on windows of half-period means): this test guards 35 s, not
+// §1's 30.
 TEST(FrfExperiment, TheThreeMassChainsModesWithFriction) {
   const std::vector<double> hz{38.092956, 68.654230, 271.468822, 319.524083};
   for (double level : {0.085, 0.5}) {
@@ -307,7 +309,12 @@ TEST(FrfExperiment, TheThreeMassChainsModesWithFriction) {
     ASSERT_EQ(c.inertias.size(), 3u);
     for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(c.inertias[i].value / chain.inertia[i], 1.0, 0.02) << level << " J" << i;
     for (std::size_t i = 0; i < 2; ++i) EXPECT_NEAR(c.stiffnesses[i].value / chain.stiffness[i], 1.0, 0.02) << level << " k" << i;
-    EXPECT_NEAR(c.model.modes.front().antiresonance.zeta / 0.0026998, 1.0, 0.6) << level;
+    const std::vector<double> zeta{0.0026998, 0.0051245, 0.0089038, 0.0092760};
+    for (std::size_t i = 0; i < 2; ++i) {
+      EXPECT_NEAR(c.model.modes[i].antiresonance.zeta / zeta[2 * i], 1.0, 0.2) << level << " mode " << i;
+      EXPECT_NEAR(c.model.modes[i].resonance.zeta / zeta[2 * i + 1], 1.0, 0.2) << level << " mode " << i;
+    }
+    EXPECT_LT(c.model.rigid == fit::RigidKind::kRealPole ? c.model.rigid_pole_rad_s / kTwoPi : 0.0, 0.1) << level;
   }
 }
 

@@ -7,13 +7,14 @@
 /// of points defeat it: a point whose response is small against the sensor noise (the half-period
 /// change stays several times the allowance although P is steady: it waits for a lucky pair or for
 /// its time limit), and a point beside a lightly damped mode, whose estimate carries the mode's
-/// ringing as a slow beat (the change is small at the beat's turning points, so it may pass by
+/// ringing as a slow beat (the change is small at the beat's turning points, so it passes by
 /// chance with the ringing still in). Means over W half periods average the noise by √W and the
-/// beat over its period; comparing the means of the last two windows, and requiring the last
-/// window's standard error (the spread of its half-period means over √W) to be within twice the
-/// same bound, tells a steady point from one still ringing. W = 2, 4, 8, … up to a time span
-/// (RfidBlock uses 0.25 s, so the test acts above 4 Hz and leaves the long low-frequency periods to
-/// the single test).
+/// beat over its period; the test here compares the means of the last two windows and requires the
+/// last window's standard error (the spread of its half-period means over √W) to be within twice
+/// the same bound. W = 2, 4, 8, … up to a length the owner sets (RfidBlock: 0.25 s, so the test
+/// acts above 4 Hz and leaves the long low-frequency periods to the single test). RfidBlock uses
+/// it both ways: a window that passes settles a point the single test holds up (noise), and where
+/// windows can be formed a single pass needs a window that passes too (ringing).
 ///
 /// Fixed storage: no allocation per sample (a real-time block's member).
 
@@ -50,12 +51,20 @@ class SettleWindows {
   [[nodiscard]] std::complex<double> longest_mean(std::size_t max_window, std::complex<double> fallback) const noexcept;
 
  private:
-  /// The k-th newest stored mean (k = 0 the newest).
-  [[nodiscard]] std::complex<double> newest(std::size_t k) const noexcept;
-  /// Mean of the stored means k ∈ [first, first + w).
-  [[nodiscard]] std::complex<double> window_mean(std::size_t first, std::size_t w) const noexcept;
+  /// Running totals of the means and of their squared moduli since the last clear: a window's
+  /// sums are the difference of two, so the test costs O(log W) per half period, not O(W).
+  struct Totals {
+    std::complex<double> sum;
+    double norm = 0.0;
+  };
+  /// The totals of the k-th newest mean and all older ones (zero when k ≥ the means pushed).
+  [[nodiscard]] Totals totals_through(std::size_t k) const noexcept;
+  /// Sums over the means k ∈ [first, first + w) counted from the newest (first + w ≤ count()).
+  [[nodiscard]] Totals window(std::size_t first, std::size_t w) const noexcept;
 
-  std::array<std::complex<double>, kCapacity> means_{};
+  /// One slot more than the means kept: a window reaching the oldest kept mean subtracts the
+  /// totals just before it.
+  std::array<Totals, kCapacity + 1> totals_{};
   std::size_t pushed_ = 0;  ///< means stored since the last clear (may exceed kCapacity: a ring)
   std::complex<double> sum_;
   long samples_ = 0;
