@@ -54,6 +54,13 @@ struct Layout {
   [[nodiscard]] Eigen::Index friction_count() const { return logs() + 3; }
 };
 
+/// The friction fit is refused when its rms log error exceeds the linear fit's by this factor (on
+/// the same points): noise alone leaves the two within a few per cent.
+constexpr double kWorseThanLinear = 1.25;
+/// ... and by more than this (0.1 % relative error: on noise-free data both are near 0 and their
+/// ratio means nothing).
+constexpr double kNegligibleRms = 1e-3;
+
 /// What the residuals need besides θ.
 struct Context {
   double viscous = 1.0;   ///< bv_ref
@@ -183,7 +190,7 @@ void errors_in_variables(const Eigen::VectorXd& t, const Context& c, std::vector
 
 /// A value and its standard deviation from θ's covariance by the delta method, g = ∂value/∂θ.
 Estimate delta(double value, const Eigen::VectorXd& g, const Eigen::MatrixXd& c) {
-  return {value, std::sqrt(std::max(0.0, g.dot(c * g)))};
+  return {value, detail::std_of_variance(g.dot(c * g))};
 }
 
 /// Numerical gradient of a scalar function of θ (central differences on θ's own scale).
@@ -222,7 +229,7 @@ void fill_estimates(CoulombFit& out, const Eigen::VectorXd& t, const Eigen::Matr
   const Layout& l = ctx.layout;
   const bool load = ctx.sensor == SensorSide::kLoad;
   auto scaled_param = [&](Eigen::Index i, double scale) {
-    return Estimate{t[i] * scale, scale * std::sqrt(std::max(0.0, c(i, i)))};
+    return Estimate{t[i] * scale, scale * detail::std_of_variance(c(i, i))};
   };
   // On the load side the inertias, k and bs are functions of θ: delta method.
   const auto physical = [&](std::vector<double> ChainParameters::*member, std::size_t i) {
@@ -245,7 +252,7 @@ void fill_estimates(CoulombFit& out, const Eigen::VectorXd& t, const Eigen::Matr
   out.total_inertia = load ? detail::log_estimate(t, c, 0) : Estimate{p.total_inertia(), kNan};
   if (load) {
     const double share = motor_share(t);
-    out.motor_share = {share, share * (1.0 - share) * std::sqrt(std::max(0.0, c(1, 1)))};
+    out.motor_share = {share, share * (1.0 - share) * detail::std_of_variance(c(1, 1))};
   } else {
     out.motor_share = {p.inertia.front() / p.total_inertia(), kNan};
   }
@@ -256,7 +263,7 @@ void fill_estimates(CoulombFit& out, const Eigen::VectorXd& t, const Eigen::Matr
   // K = p/J1 (p/ΣJ on the load side; without a lag p = 1): ln K = ln p − θ[0].
   double var_ln_gain = c(0, 0);
   if (l.lag >= 0) var_ln_gain += c(l.lag, l.lag) - 2.0 * c(0, l.lag);
-  out.gain = {out.model.gain, out.model.gain * std::sqrt(std::max(0.0, var_ln_gain))};
+  out.gain = {out.model.gain, out.model.gain * detail::std_of_variance(var_ln_gain)};
   out.lag_pole_rad_s = l.lag >= 0 ? detail::log_estimate(t, c, l.lag) : Estimate{kNan, kNan};
   out.delay_s = l.delay >= 0 ? scaled_param(l.delay, ctx.time) : Estimate{kNan, kNan};
   out.theta = t;
@@ -368,6 +375,15 @@ std::complex<double> coulomb_chain_response(double omega_rad_s, double velocity_
                                             SensorSide sensor) {
   if (inertias.size() < 2 || stiffnesses.size() + 1 != inertias.size() || dampings.size() != stiffnesses.size())
     throw std::invalid_argument("coulomb_chain_response: n + 1 inertias need n stiffnesses and n dampings");
+  const auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
+  const auto non_negative = [](double x) { return x >= 0.0 && std::isfinite(x); };
+  if (!std::all_of(inertias.begin(), inertias.end(), positive) ||
+      !std::all_of(stiffnesses.begin(), stiffnesses.end(), positive) ||
+      !std::all_of(dampings.begin(), dampings.end(), non_negative) || !non_negative(bv) || !non_negative(mm) ||
+      !non_negative(ml) || !positive(omega_rad_s) || !positive(velocity_amplitude))
+    throw std::invalid_argument(
+        "coulomb_chain_response: inertias, stiffnesses, frequency and velocity amplitude must be finite and > 0, "
+        "dampings and friction levels finite and >= 0");
   return detail::chain_response(omega_rad_s, velocity_amplitude, {inertias, stiffnesses, dampings, bv, mm, ml},
                                 linear_model, sensor);
 }
@@ -474,6 +490,19 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   out.weighting = known_std ? "std_dev" : "log-relative";
   out.rms_log_error = unweighted_rms(best.residual, points);
   out.linear_rms_log_error = linear.result.rms_log_error;
+  // A chain's shafts give each mode its damping only through n dampers: a response whose modal
+  // dampings no chain reproduces (or whose data are not a chain's: a wrong --output-kind or
+  // --sensor) makes the friction absorb the rest and fit worse than the linear model. Such a fit
+  // is not written.
+  if (out.rms_log_error > kWorseThanLinear * out.linear_rms_log_error + kNegligibleRms) {
+    out.fitted = false;
+    out.note = fmt::format(
+        "Coulomb friction not fitted: the {} with friction fits worse than the linear fit (rms log error {:.3g} "
+        "against {:.3g}): the response is not that of a chain with friction on its ends (check --output-kind and "
+        "--sensor); the linear fit is kept",
+        chain_name(layout.shafts), out.rms_log_error, out.linear_rms_log_error);
+    return out;
+  }
   Eigen::MatrixXd covariance = free_covariance(best, known_std, fixed);
   std::string held;
   const bool share_held = load && !covariance.allFinite();

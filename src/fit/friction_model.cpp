@@ -92,8 +92,8 @@ Complex load_side(double omega, double vl, const ChainParameters& p) {
   return 1.0 / ((p.inertia[0] * s + p.bv + cm) * e.velocity + e.force);
 }
 
-/// The linear chain's polynomials: the walk with cl = 0 in s, multiplied through by the shafts'
-/// (bi s + ki)/s. Vm/Vl = U/Q, F1/Vl = F/Q with Q = Π(bi s + ki): the motor-side admittance is
+/// The linear chain's polynomials: the walk with cl = 0 in s, each step's shaft impedance
+/// (bi s + ki)/s cleared by multiplying through with bi s + ki. Vm/Vl = U/Q, F1/Vl = F/Q with Q = Π(bi s + ki): the motor-side admittance is
 /// U/((J1 s + bv)U + F), the load side's Q/((J1 s + bv)U + F).
 struct ChainPolynomials {
   core::Polynomial u, f, q;

@@ -41,7 +41,7 @@ std::complex<double> chain_response(double omega, double velocity_amplitude, con
 /// p/ΣJ. Output, lag and delay from `actuator`.
 PlantModel chain_linear_part(const ChainParameters& p, const PlantModel& actuator, RigidKind rigid, SensorSide sensor);
 
-/// The undamped chain whose motor-side admittance is K/s·Π(s² + ωz_i²)/(s² + ωp_i²) (K = `gain`,
+/// The undamped chain whose motor-side admittance is K/s·Π(s² + ωz_i²)/Π(s² + ωp_i²) (K = `gain`,
 /// the lag's factor taken out), by Cauer's first continued fraction of its impedance about s = ∞:
 /// Z = J1 s + 1/(s/k1 + 1/(J2 s + …)). Shaft i's damping starts at 2ζp_i k_i/ωp_i (exact for one
 /// shaft up to the motor's share). Empty with `why` when the modes do not interlace as a chain's

@@ -49,9 +49,11 @@ MisfitScale misfit_scale(const Eigen::VectorXd& r, double dof, bool known_std) {
                              std::sqrt(kappa), rho)};
 }
 
+double std_of_variance(double variance) { return variance < 0.0 ? 0.0 : std::sqrt(variance); }
+
 Estimate log_estimate(const Eigen::VectorXd& t, const Eigen::MatrixXd& c, Eigen::Index i, double sign) {
   const double v = sign * std::exp(t[i]);
-  return {v, std::abs(v) * std::sqrt(std::max(0.0, c(i, i)))};
+  return {v, std::abs(v) * std_of_variance(c(i, i))};
 }
 
 bool better_run(const core::LmResult& run, const core::LmResult& best) {

@@ -33,6 +33,10 @@ struct MisfitScale {
 };
 MisfitScale misfit_scale(const Eigen::VectorXd& r, double dof, bool known_std);
 
+/// The standard deviation of a variance: a slightly negative one (rounding) is 0, a NaN one (a
+/// singular covariance: not identifiable) stays NaN, so that the output says "unknown", not "exact".
+double std_of_variance(double variance);
+
 /// A positive parameter fitted by its logarithm θi: sign·exp(θi) and its std by the delta method,
 /// |value|·sqrt(c_ii).
 Estimate log_estimate(const Eigen::VectorXd& t, const Eigen::MatrixXd& c, Eigen::Index i, double sign = 1.0);

@@ -76,17 +76,20 @@ json nonlinear_json(const fit::NonlinearMechanics& n) {
 }
 
 json friction_json(const fit::CoulombFit& c) {
-  const auto values = [](const std::vector<fit::Estimate>& v) {
+  const auto values = [](const std::vector<fit::Estimate>& v, bool std) {
     json a = json::array();
-    for (const fit::Estimate& e : v) a.push_back(e.value);
+    for (const fit::Estimate& e : v) a.push_back(std ? number_or_null(e.std) : json(e.value));
     return a;
   };
   const std::size_t masses = c.inertias.size();
   return {{"model", masses <= 2 ? std::string("two-mass, Coulomb on motor and load")
-                                : std::to_string(masses) + "-mass chain, Coulomb on motor and load"},
-          {"inertias", values(c.inertias)},
-          {"stiffnesses", values(c.stiffnesses)},
-          {"shaft_dampings", values(c.shaft_dampings)},
+                                : std::to_string(masses) + "-mass chain, Coulomb on motor and load (motor first)"},
+          {"inertias", values(c.inertias, false)},
+          {"inertias_std", values(c.inertias, true)},
+          {"stiffnesses", values(c.stiffnesses, false)},
+          {"stiffnesses_std", values(c.stiffnesses, true)},
+          {"shaft_dampings", values(c.shaft_dampings, false)},
+          {"shaft_dampings_std", values(c.shaft_dampings, true)},
           {"motor_coulomb", c.motor_coulomb.value},
           {"motor_coulomb_std", number_or_null(c.motor_coulomb.std)},
           {"load_coulomb", c.load_coulomb.value},

@@ -500,9 +500,13 @@ TEST(FrictionFit, AThreeMassChainsDampingsComeBackWithItsFriction) {
   const CoulombFit f = fit_coulomb_friction(r, linear, o);
   ASSERT_TRUE(f.fitted) << f.note;
   ASSERT_EQ(f.inertias.size(), 3u);
-  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(f.inertias[i].value, c.j[i], 4.0 * f.inertias[i].std) << i;
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(f.inertias[i].value, c.j[i], 4.0 * f.inertias[i].std) << i;
+    EXPECT_LT(f.inertias[i].std, 0.02 * c.j[i]) << i;
+  }
   for (std::size_t i = 0; i < 2; ++i) {
     EXPECT_NEAR(f.stiffnesses[i].value, c.k[i], 4.0 * f.stiffnesses[i].std) << i;
+    EXPECT_LT(f.stiffnesses[i].std, 0.02 * c.k[i]) << i;
     EXPECT_NEAR(f.shaft_dampings[i].value, c.b[i], 4.0 * f.shaft_dampings[i].std) << i;
     EXPECT_LT(f.shaft_dampings[i].std, 0.1 * c.b[i]) << i;
   }
@@ -519,6 +523,89 @@ TEST(FrictionFit, AThreeMassChainsDampingsComeBackWithItsFriction) {
     EXPECT_NEAR(f.model.modes[i].resonance.zeta / zeta_p[i], 1.0, 0.2) << i;
   }
   EXPECT_GT(linear.result.model.modes[0].antiresonance.zeta, 1.5 * zeta_z[0]);
+}
+
+TEST(FrictionFit, ANoiseFreeChainComesBackExactly) {
+  // Reference: the 3×3 chain equations without friction, noise-free. The two-mode linear fit
+  // describes them exactly; Cauer's chain of its modes starts the friction fit, which must return
+  // the chain's own inertias, stiffnesses and shaft dampings (to 1e-5: the linear fit's own
+  // convergence) and no friction.
+  const ChainBench c;
+  core::FrequencyResponse r;
+  r.quality_kind = core::QualityKind::kThd;
+  for (int i = 0; i < 60; ++i) {
+    core::FrequencyPoint q;
+    q.freq_hz = 2.0 * std::pow(450.0 / 2.0, i / 59.0);
+    q.value = chain_velocities(c, 2.0 * kPi * q.freq_hz, 0.0, 0.0)[0];
+    q.amplitude = 0.2;
+    r.points.push_back(q);
+  }
+  FitOptions o = with_lag();
+  o.rigid = RigidKind::kIntegrator;
+  const FitReport linear = fit_plant(r, {ModelRequest::Kind::kModes, 2}, o);
+  ASSERT_LT(linear.result.rms_log_error, 1e-6);
+  const CoulombFit f = fit_coulomb_friction(r, linear, o);
+  ASSERT_TRUE(f.fitted) << f.note;
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(f.inertias[i].value / c.j[i], 1.0, 1e-5) << i;
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_NEAR(f.stiffnesses[i].value / c.k[i], 1.0, 1e-5) << i;
+    EXPECT_NEAR(f.shaft_dampings[i].value / c.b[i], 1.0, 1e-4) << i;
+  }
+  EXPECT_LT(f.motor_coulomb.value + f.load_coulomb.value, 1e-6);
+}
+
+TEST(FrictionFit, RefusesModesNoChainHasAndBadChains) {
+  // A motor-side model whose second antiresonance lies below the first resonance: no chain of
+  // positive masses and springs has it (Cauer's fraction gives a negative element).
+  FitReport linear;
+  linear.result.converged = true;
+  PlantModel& m = linear.result.model;
+  m.gain = 500.0;
+  m.rigid = RigidKind::kIntegrator;
+  m.modes = {{{2.0 * kPi * 38.0, 0.01}, {2.0 * kPi * 68.0, 0.01}}, {{2.0 * kPi * 60.0, 0.01}, {2.0 * kPi * 320.0, 0.01}}};
+  core::FrequencyResponse r;
+  for (double hz : {10.0, 50.0, 100.0, 300.0}) r.points.push_back({hz, m.response(2.0 * kPi * hz)});
+  const CoulombFit f = fit_coulomb_friction(r, linear, {});
+  EXPECT_FALSE(f.fitted);
+  EXPECT_NE(f.note.find("do not interlace"), std::string::npos) << f.note;
+  // The chain response refuses what is no chain.
+  const ChainBench c;
+  const PlantModel a = c.actuator();
+  EXPECT_THROW((void)coulomb_chain_response(1.0, 1.0, {1e-3, 1e-3}, {100.0, 100.0}, {0.0, 0.0}, 0.0, 0.0, 0.0, a,
+                                            SensorSide::kMotor),
+               std::invalid_argument);
+  EXPECT_THROW((void)coulomb_chain_response(1.0, 0.0, c.j, c.k, c.b, 0.0, 0.1, 0.1, a, SensorSide::kMotor), std::invalid_argument);
+  EXPECT_THROW((void)coulomb_chain_response(1.0, 1.0, {1e-3, -1e-3, 1e-3}, c.k, c.b, 0.0, 0.0, 0.0, a, SensorSide::kMotor),
+               std::invalid_argument);
+}
+
+TEST(FrictionFit, AFitWorseThanTheLinearOneIsNotWritten) {
+  // Modal data whose dampings no chain of two shaft dampers reproduces (the first antiresonance
+  // ten times as damped as its neighbours), noise-free: the chain with friction cannot match the
+  // linear fit (rms log error 0) and is refused, the linear fit kept.
+  PlantModel truth;
+  truth.gain = 500.0;
+  truth.rigid = RigidKind::kIntegrator;
+  truth.lag_pole_rad_s = 1.0 / 3e-4;
+  truth.modes = {{{2.0 * kPi * 38.09, 0.05}, {2.0 * kPi * 68.65, 0.005}}, {{2.0 * kPi * 271.5, 0.009}, {2.0 * kPi * 319.5, 0.009}}};
+  core::FrequencyResponse r;
+  r.quality_kind = core::QualityKind::kThd;
+  for (int i = 0; i < 60; ++i) {
+    core::FrequencyPoint q;
+    q.freq_hz = 2.0 * std::pow(450.0 / 2.0, i / 59.0);
+    // PlantModel's lag is 1/(s + p): the gain carries p, as a fit's does.
+    q.value = truth.response(2.0 * kPi * q.freq_hz) * (1.0 / 3e-4);
+    q.amplitude = 0.2;
+    r.points.push_back(q);
+  }
+  FitOptions o = with_lag();
+  o.rigid = RigidKind::kIntegrator;
+  const FitReport linear = fit_plant(r, {ModelRequest::Kind::kModes, 2}, o);
+  ASSERT_LT(linear.result.rms_log_error, 1e-6);
+  const CoulombFit f = fit_coulomb_friction(r, linear, o);
+  EXPECT_FALSE(f.fitted);
+  EXPECT_NE(f.note.find("fits worse than the linear fit"), std::string::npos) << f.note;
+  EXPECT_EQ(with_friction_model(linear, f).result.model.modes[0].antiresonance.zeta, linear.result.model.modes[0].antiresonance.zeta);
 }
 
 }  // namespace friction_test
