@@ -135,11 +135,10 @@ void print_friction(const fit::CoulombFit& c) {
     fmt::print("  {:<8}resonance     {} Hz, zeta {}\n", motor ? "" : fmt::format("mode {}:", i + 1),
                pm(m.resonance.omega_rad_s / kTwoPi, u.resonance_omega.std / kTwoPi), pm(m.resonance.zeta, u.resonance_zeta.std));
   }
-  if (!motor) {
+  if (!motor)
     fmt::print("  total inertia J = {}, motor's share Jm/J = {} (seen through the friction only)\n",
                pm(c.total_inertia.value, c.total_inertia.std), pm(c.motor_share.value, c.motor_share.std));
-    return;
-  }
+  if (!motor && c.stiffnesses.size() == 1) return;
   if (c.stiffnesses.size() != 1) {
     fmt::print("  inertias       = {} (motor first)\n  stiffnesses    = {}\n  shaft dampings = {}\n", estimates(c.inertias),
                estimates(c.stiffnesses), estimates(c.shaft_dampings));
@@ -259,8 +258,8 @@ void register_fit(CLI::App& app, Action& selected) {
       ->check(CLI::ExistingFile);
   cmd->add_flag("--friction", a->friction,
                 "Also fit Coulomb friction on motor and load (a mass chain of one mass more than the fitted modes, "
-                "motor side; one mode from the load side; describing functions at each point's excitation "
-                "amplitude, swept-sine responses): friction is told apart from "
+                "either --sensor; describing functions at each point's excitation amplitude, swept-sine "
+                "responses): friction is told apart from "
                 "the linear damping, and -o writes the linear part");
   add_report_option(*cmd, a->report);
   set_examples(*cmd,

@@ -87,12 +87,21 @@ ChainParameters physical_of(const Eigen::VectorXd& t, const Context& c) {
   const Layout& l = c.layout;
   const double viscous = t[l.viscous()] * c.viscous, mm = t[l.motor_coulomb()] * c.torque;
   const double ml = t[l.load_coulomb()] * c.torque;
-  if (c.sensor == SensorSide::kLoad) {
+  if (c.sensor == SensorSide::kLoad && l.shafts == 1) {
     const double total = std::exp(t[0]), share = motor_share(t), q = 4.0 * share * (1.0 - share);
     return detail::two_mass_chain(share * total, (1.0 - share) * total, q * std::exp(t[2]), q * std::exp(t[3]), viscous, mm, ml);
   }
   ChainParameters p;
-  for (std::size_t i = 0; i <= l.shafts; ++i) p.inertia.push_back(std::exp(t[l.inertia(i)]));
+  if (c.sensor == SensorSide::kLoad) {
+    // ln ΣJ, then each further mass's log ratio to the motor's.
+    double weights = 1.0;
+    for (std::size_t i = 1; i <= l.shafts; ++i) weights += std::exp(t[l.inertia(i)]);
+    const double motor = std::exp(t[0]) / weights;
+    p.inertia.push_back(motor);
+    for (std::size_t i = 1; i <= l.shafts; ++i) p.inertia.push_back(motor * std::exp(t[l.inertia(i)]));
+  } else {
+    for (std::size_t i = 0; i <= l.shafts; ++i) p.inertia.push_back(std::exp(t[l.inertia(i)]));
+  }
   for (std::size_t i = 0; i < l.shafts; ++i) {
     p.stiffness.push_back(std::exp(t[l.stiffness(i)]));
     p.damping.push_back(std::exp(t[l.damping(i)]));
@@ -250,9 +259,15 @@ void fill_estimates(CoulombFit& out, const Eigen::VectorXd& t, const Eigen::Matr
   out.stiffness = l.shafts == 1 ? out.stiffnesses.front() : Estimate{kNan, kNan};
   out.shaft_damping = l.shafts == 1 ? out.shaft_dampings.front() : Estimate{kNan, kNan};
   out.total_inertia = load ? detail::log_estimate(t, c, 0) : Estimate{p.total_inertia(), kNan};
-  if (load) {
+  if (load && l.shafts == 1) {
     const double share = motor_share(t);
     out.motor_share = {share, share * (1.0 - share) * detail::std_of_variance(c(1, 1))};
+  } else if (load) {
+    const auto share = [&](const Eigen::VectorXd& x) {
+      const ChainParameters q = physical_of(x, ctx);
+      return q.inertia.front() / q.total_inertia();
+    };
+    out.motor_share = delta(share(t), gradient(t, share), c);
   } else {
     out.motor_share = {p.inertia.front() / p.total_inertia(), kNan};
   }
@@ -313,6 +328,30 @@ std::vector<Point> fitted_points(const core::FrequencyResponse& response, const 
   return points;
 }
 
+/// The start of a load-side chain of n > 1 shafts: a load encoder's response gives the total
+/// inertia and the resonances only (n + 1 numbers for 2n + 1 inertias and stiffnesses), so the
+/// antiresonances the motor would show are guessed where a chain's lie between its resonances
+/// (ωz1 = ωp1/√2, then the geometric means of neighbouring resonances) and Cauer's chain of those
+/// modes, scaled to the measured total inertia, starts the fit; the friction, acting at the two
+/// ends' velocities, is what moves the split (its std says how well).
+std::optional<ChainParameters> load_side_chain(const PlantModel& lin, std::string& why) {
+  std::vector<Mode> modes;
+  for (std::size_t i = 0; i < lin.modes.size(); ++i) {
+    Mode m = lin.modes[i];
+    m.antiresonance.omega_rad_s = i == 0 ? m.resonance.omega_rad_s / std::sqrt(2.0)
+                                         : std::sqrt(m.resonance.omega_rad_s * lin.modes[i - 1].resonance.omega_rad_s);
+    modes.push_back(m);
+  }
+  // Low-frequency asymptote K·Πωz²/Πωp²/s = 1/(ΣJ s).
+  const double total = (lin.lag_pole_rad_s ? *lin.lag_pole_rad_s : 1.0) / lin.gain;
+  double k = 1.0 / total;
+  for (const Mode& m : modes) k *= (m.resonance.omega_rad_s * m.resonance.omega_rad_s) /
+                                   (m.antiresonance.omega_rad_s * m.antiresonance.omega_rad_s);
+  std::optional<ChainParameters> chain = detail::chain_of_modes(modes, k, why);
+  if (!chain) why = "Coulomb friction not fitted: no chain for the load-side resonances (" + why + ")";
+  return chain;
+}
+
 /// "two-mass model", "three-mass chain", "4-mass chain".
 std::string chain_name(std::size_t shafts) {
   if (shafts == 1) return "two-mass model";
@@ -340,12 +379,11 @@ std::optional<ChainParameters> linear_chain(const FitReport& linear, double moto
     return detail::two_mass_chain(start->motor_inertia.value, start->load_inertia.value, start->stiffness.value,
                                   start->damping.value, 0.0, 0.0, 0.0);
   }
-  if (lin.modes.size() != 1 || !(lin.gain > 0.0)) {
-    why = "Coulomb friction not fitted: a load-side fit needs one mode and a positive gain (it has " +
-          std::to_string(lin.modes.size()) +
-          " mode(s); a longer chain seen from the load does not tell its inertias and stiffnesses apart)";
+  if (lin.modes.empty() || !(lin.gain > 0.0)) {
+    why = "Coulomb friction not fitted: a load-side fit needs a mode and a positive gain";
     return std::nullopt;
   }
+  if (lin.modes.size() > 1) return load_side_chain(lin, why);
   const double total = lag / lin.gain;
   const double jm = motor_fraction * total, jl = (1.0 - motor_fraction) * total, mu = jm * jl / total;
   const ModalPair& res = lin.modes.front().resonance;
@@ -413,8 +451,8 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   std::nth_element(amplitudes.begin(), amplitudes.begin() + static_cast<std::ptrdiff_t>(m / 2), amplitudes.end());
   const double jm0 = start->inertia.front(), total0 = start->total_inertia();
   // The first antiresonance, the unit of the viscous damping and the delay (two masses: √(k/Jl)).
-  const double wz0 = start->shafts() == 1 ? std::sqrt(start->stiffness.front() / start->inertia.back())
-                                          : lin.modes.front().antiresonance.omega_rad_s;
+  const double wz0 = start->shafts() == 1 || load ? std::sqrt(start->stiffness.back() / start->inertia.back())
+                                                   : lin.modes.front().antiresonance.omega_rad_s;
   const Context ctx{jm0 * wz0, amplitudes[m / 2], 1.0 / wz0, lin, lin.sensor, layout};
 
   core::LmOptions lo;
@@ -430,9 +468,12 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   (*lo.lower)[layout.load_coulomb()] = 0.0;
   if (fixed_integrator) (*lo.upper)[layout.viscous()] = 0.0;
   if (load) {
-    // The share within [0.007, 0.993]: a chain whose one mass vanishes is not a two-mass chain.
-    (*lo.lower)[1] = -5.0;
-    (*lo.upper)[1] = 5.0;
+    // The share within [0.007, 0.993]: a chain whose one mass vanishes is not a two-mass chain
+    // (a longer chain: each mass within e^±5 of the motor's).
+    for (std::size_t i = 1; i <= layout.shafts; ++i) {
+      (*lo.lower)[layout.inertia(i)] = -5.0;
+      (*lo.upper)[layout.inertia(i)] = 5.0;
+    }
   }
   const auto f = [&](const Eigen::VectorXd& t, Eigen::VectorXd& res, Eigen::MatrixXd*) {
     return residuals(t, points, ctx, res);
@@ -454,7 +495,8 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
     for (std::size_t i = 0; i <= layout.shafts; ++i) t[layout.inertia(i)] = std::log(start->inertia[i]);
     if (load) {
       t[0] = std::log(total0);
-      t[1] = 0.0;
+      for (std::size_t i = 1; i <= layout.shafts; ++i)
+        t[layout.inertia(i)] = layout.shafts == 1 ? 0.0 : std::log(start->inertia[i] / start->inertia.front());
     }
     for (std::size_t i = 0; i < layout.shafts; ++i) {
       t[layout.stiffness(i)] = std::log(start->stiffness[i]);
@@ -472,7 +514,10 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   }
   out.points = m;
   if (!std::isfinite(best.cost) || !best.converged()) {
-    out.note = "Coulomb friction fit did not converge: " + (std::isfinite(best.cost) ? best.message : "no valid start");
+    out.note = "Coulomb friction fit did not converge: " + (std::isfinite(best.cost) ? best.message : "no valid start") +
+               (load && layout.shafts > 1 ? " (from the load encoder a chain's split along its masses shows only through "
+                                            "its friction: with little friction it is not determined)"
+                                          : "");
     return out;
   }
   // Second pass with the errors-in-variables weights of the first solution (kept when it fails).
@@ -506,7 +551,11 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   Eigen::MatrixXd covariance = free_covariance(best, known_std, fixed);
   std::string held;
   const bool share_held = load && !covariance.allFinite();
-  if (share_held) {
+  if (share_held && layout.shafts > 1) {
+    for (std::size_t i = 1; i <= layout.shafts; ++i) fixed.push_back(layout.inertia(i));
+    covariance = free_covariance(best, known_std, fixed);
+    held = "; the inertias' split along the chain is not seen (too little friction) and is held";
+  } else if (share_held) {
     // Friction too small to tell the split (a singular Jacobian): the share stays where LM left it
     // and is no parameter; its std and those of the inertias are then unknown (NaN), not 0.
     fixed.push_back(1);
@@ -520,7 +569,10 @@ CoulombFit fit_coulomb_friction(const core::FrequencyResponse& response, const F
   out.uncertainty_scale = misfit.factor;
   out.uncertainty_note = misfit.note;
   fill_estimates(out, best.parameters, covariance * misfit.factor, ctx, options.rigid);
-  if (share_held) out.motor_share.std = out.motor_inertia.std = out.load_inertia.std = kNan;
+  if (share_held) {
+    out.motor_share.std = out.motor_inertia.std = out.load_inertia.std = kNan;
+    for (Estimate& e : out.inertias) e.std = kNan;
+  }
   out.note = chain_name(layout.shafts) +
              " with Coulomb friction on motor and load (describing functions at each point's measured amplitude" +
              (load ? ", seen from the load encoder" : "") + "), " + std::to_string(m) + " points" + held;

@@ -608,6 +608,51 @@ TEST(FrictionFit, AFitWorseThanTheLinearOneIsNotWritten) {
   EXPECT_EQ(with_friction_model(linear, f).result.model.modes[0].antiresonance.zeta, linear.result.model.modes[0].antiresonance.zeta);
 }
 
+TEST(FrictionFit, AThreeMassChainSeenFromTheLoad) {
+  // The three-mass chain's load encoder with Coulomb friction on motor and load, made by the
+  // brute-force balance (torque amplitudes rising towards low frequencies and above the second
+  // resonance, as the amplitude adaptation does; points where the load sticks are left out, as a
+  // measurement marks them invalid; 0.5 % noise). Reference: the chain's resonances and their
+  // dampings from tools/reference/mass_chain_modes.py. The linear load-side fit reads the friction
+  // as damping of the first resonance; the chain with friction, started from guessed
+  // antiresonances, must give both resonances within 0.5 % and their dampings within 20 %.
+  ChainBench c;
+  c.mm = 0.1;
+  c.ml = 0.1;
+  core::FrequencyResponse r;
+  r.quality_kind = core::QualityKind::kThd;
+  std::mt19937 rng(31);
+  std::normal_distribution<double> noise(0.0, 0.005 / std::sqrt(2.0));
+  for (int i = 0; i < 90; ++i) {
+    const double f = 2.0 * std::pow(450.0 / 2.0, i / 89.0);
+    const double torque = 0.3 * (1.0 + 3.0 / f) * (1.0 + (f / 150.0) * (f / 150.0));
+    bool stuck = false;
+    const Complex p = chain_balance(c, 2.0 * kPi * f, torque, stuck)[2];
+    if (stuck) continue;
+    core::FrequencyPoint q;
+    q.freq_hz = f;
+    q.value = p * Complex(1.0 + noise(rng), noise(rng));
+    q.amplitude = torque;
+    r.points.push_back(q);
+  }
+  FitOptions o = with_lag();
+  o.sensor = SensorSide::kLoad;
+  const FitReport linear = fit_plant(r, {ModelRequest::Kind::kModes, 2}, o);
+  ASSERT_TRUE(linear.result.converged) << linear.result.message;
+  const std::vector<double> hz{68.654230, 319.524083}, zeta{0.0051245, 0.0092760};
+  EXPECT_GT(linear.result.model.modes[0].resonance.zeta, 1.2 * zeta[0]);  // friction read as damping
+  const CoulombFit f = fit_coulomb_friction(r, linear, o);
+  ASSERT_TRUE(f.fitted) << f.note;
+  ASSERT_EQ(f.model.modes.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_NEAR(f.model.modes[i].resonance.omega_rad_s / (2.0 * kPi * hz[i]), 1.0, 0.005) << i;
+    EXPECT_NEAR(f.model.modes[i].resonance.zeta / zeta[i], 1.0, 0.2) << i;
+  }
+  EXPECT_NEAR(f.total_inertia.value / 9e-3, 1.0, 0.02);
+  EXPECT_NEAR(f.motor_coulomb.value, c.mm, 4.0 * f.motor_coulomb.std);
+  EXPECT_NEAR(f.load_coulomb.value, c.ml, 4.0 * f.load_coulomb.std);
+}
+
 }  // namespace friction_test
 }  // namespace
 }  // namespace servotwin::fit
