@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <numbers>
 
+#include <nlohmann/json.hpp>
+
 #include "cli_support.hpp"
 #include "servotwin/io/frf_csv.hpp"
 #include "servotwin/io/plant_model_json.hpp"
@@ -103,6 +105,29 @@ TEST_F(Cli, FitWithFrictionWritesTheLinearPart) {
   const std::string json = slurp(path("model.json"));
   EXPECT_NE(json.find("\"friction\""), std::string::npos);
   EXPECT_NE(json.find("\"load_coulomb\""), std::string::npos);
+}
+
+// The three-mass chain of the tuning study with Coulomb friction 0.5 N m (3× the start amplitude)
+// on motor and load (issue 25 §1): `fit --model modes:2 --friction` fits a chain of three masses
+// and writes its linear part, with the chain in the friction block. Reference: the chain's own
+// inertias and its first antiresonance damping 0.0027 (tools/reference/mass_chain_modes.py).
+TEST_F(Cli, FitWithFrictionOfAThreeMassChain) {
+  write("chain.json", R"({"format": "servotwin.plant/1", "type": "mass-chain", "inertias": [2e-3, 1e-3, 6e-3],
+    "stiffnesses": [2500, 400], "dampings": [0.02, 0.01], "coulomb": [0.5, 0, 0.5], "stick_band": 0.001,
+    "noise_std": 0.01, "ts": 0.000125, "current_lag": 0.0003})");
+  ASSERT_EQ(run("-q frf measure --plant chain.json --range-hz 1:500 -o frf.csv").status, 0);
+  const Result f = run("fit frf.csv --model modes:2 --lag --delay --friction -o model.json");
+  ASSERT_EQ(f.status, 0) << f.err;
+  EXPECT_NE(f.out.find("three-mass chain with Coulomb friction"), std::string::npos) << f.out;
+  EXPECT_NE(f.out.find("inertias       = "), std::string::npos) << f.out;
+  const io::LoadedPlantModel back = io::load_plant_model(path("model.json").string());
+  ASSERT_EQ(back.model.modes.size(), 2u);
+  EXPECT_NEAR(back.model.modes.front().antiresonance.zeta / 0.0027, 1.0, 0.2);
+  const auto json = nlohmann::json::parse(slurp(path("model.json")));
+  const auto& inertias = json.at("friction").at("inertias");
+  ASSERT_EQ(inertias.size(), 3u);
+  EXPECT_NEAR(inertias[2].get<double>() / 6e-3, 1.0, 0.02);
+  EXPECT_EQ(json.at("friction").at("inertias_std").size(), 3u);
 }
 
 // A load encoder's response (issue 25 §1): the motor-side fit says how to fit it, --sensor load
