@@ -68,6 +68,9 @@ class SettleWindows {
   std::size_t pushed_ = 0;  ///< means stored since the last clear (may exceed kCapacity: a ring)
   std::complex<double> sum_;
   long samples_ = 0;
+  /// The first mean after a clear: the totals accumulate the means' differences from it, so that
+  /// Σ|m|² − w|mean|² does not lose the spread to a large early mean.
+  std::complex<double> reference_;
 };
 
 }  // namespace servotwin::frf
