@@ -36,12 +36,12 @@
 /// on different velocities. The share Jm/J is fitted from 1/2 and, when the friction is too small
 /// to tell it (a singular Jacobian), held where LM left it (its std NaN) and said so in the note;
 /// short of that its std tells how well it is seen. (With the motor's viscous damping bv the
-/// linear part sees the split too, weakly.) A load-side fit of n > 1 modes starts a chain of n + 1
+/// linear part sees the split too, weakly.) A load-side fit of n > 1 modes starts chains of n + 1
 /// masses from the total inertia and the resonances, with the antiresonances a motor encoder
-/// would show guessed between them (ωz1 = ωp1/√2, then geometric means of neighbouring
-/// resonances; Cauer's chain of those modes): the linear part gives n + 1 numbers for 2n + 1
-/// inertias and stiffnesses, and only the friction tells the rest (on data of the chain itself
-/// the split comes back to 0.2 %; without friction the fit does not converge and says why).
+/// would show guessed between them (0.3, 0.6, 0.9 of the way in log frequency, 3^n starts;
+/// Cauer's chain of each guess): the linear part gives n + 1 numbers for 2n + 1 inertias and
+/// stiffnesses, and only the friction tells the rest (on data of the chain itself the split comes
+/// back to 0.2 %; without friction the fit does not converge and says why).
 /// Levenberg–Marquardt fits (ln Ji, ln ki, ln bi, bv, Mm, Ml, and
 /// the lag pole and delay when the linear fit has them: friction bends its phase, and with it the
 /// lag) to the complex log errors of the points the linear fit used (its left-out points stay out),
