@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <complex>
+#include <functional>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -433,6 +434,32 @@ Eigen::Vector3cd chain_balance(const ChainBench& c, double omega, double torque,
   return v;
 }
 
+/// A swept-sine response of the chain made by the brute-force balance above: 90 points from 2 to
+/// 450 Hz at the torque amplitude `torque(f)`, 0.5 % complex noise, each point with its
+/// amplitude, seen from `side`'s encoder; a load that sticks gives the load encoder no signal, so
+/// there the point is left out (as a measurement marks it invalid).
+core::FrequencyResponse chain_sweep(const ChainBench& c, unsigned seed, SensorSide side,
+                                    const std::function<double(double)>& torque) {
+  core::FrequencyResponse r;
+  r.quality_kind = core::QualityKind::kThd;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.005 / std::sqrt(2.0));
+  const bool load = side == SensorSide::kLoad;
+  for (int i = 0; i < 90; ++i) {
+    const double f = 2.0 * std::pow(450.0 / 2.0, i / 89.0);
+    const double t = torque(f);
+    bool stuck = false;
+    const Complex p = chain_balance(c, 2.0 * kPi * f, t, stuck)[load ? 2 : 0];
+    if (load && stuck) continue;
+    core::FrequencyPoint q;
+    q.freq_hz = f;
+    q.value = p * Complex(1.0 + noise(rng), noise(rng));
+    q.amplitude = t;
+    r.points.push_back(q);
+  }
+  return r;
+}
+
 TEST(FrictionFit, AThreeMassChainsResponseIsTheHarmonicBalanceOfItsEquations) {
   // Reference: the chain's 3×3 equations, solved directly without friction and by the brute-force
   // iteration of both describing functions with it; the closed form takes the measured side's
@@ -479,21 +506,8 @@ TEST(FrictionFit, AThreeMassChainsDampingsComeBackWithItsFriction) {
   ChainBench c;
   c.mm = 0.03;
   c.ml = 0.03;
-  core::FrequencyResponse r;
-  r.quality_kind = core::QualityKind::kThd;
-  std::mt19937 rng(21);
-  std::normal_distribution<double> noise(0.0, 0.005 / std::sqrt(2.0));
-  for (int i = 0; i < 90; ++i) {
-    const double f = 2.0 * std::pow(450.0 / 2.0, i / 89.0);
-    const double torque = 0.12 * (1.0 + 3.0 / f);
-    bool stuck = false;
-    const Complex p = chain_balance(c, 2.0 * kPi * f, torque, stuck)[0];
-    core::FrequencyPoint q;
-    q.freq_hz = f;
-    q.value = p * Complex(1.0 + noise(rng), noise(rng));
-    q.amplitude = torque;
-    r.points.push_back(q);
-  }
+  const core::FrequencyResponse r =
+      chain_sweep(c, 21, SensorSide::kMotor, [](double f) { return 0.12 * (1.0 + 3.0 / f); });
   const FitOptions o = with_lag();
   const FitReport linear = fit_plant(r, {ModelRequest::Kind::kModes, 2}, o);
   ASSERT_TRUE(linear.result.converged) << linear.result.message;
@@ -619,22 +633,8 @@ TEST(FrictionFit, AThreeMassChainSeenFromTheLoad) {
   ChainBench c;
   c.mm = 0.1;
   c.ml = 0.1;
-  core::FrequencyResponse r;
-  r.quality_kind = core::QualityKind::kThd;
-  std::mt19937 rng(31);
-  std::normal_distribution<double> noise(0.0, 0.005 / std::sqrt(2.0));
-  for (int i = 0; i < 90; ++i) {
-    const double f = 2.0 * std::pow(450.0 / 2.0, i / 89.0);
-    const double torque = 0.3 * (1.0 + 3.0 / f) * (1.0 + (f / 150.0) * (f / 150.0));
-    bool stuck = false;
-    const Complex p = chain_balance(c, 2.0 * kPi * f, torque, stuck)[2];
-    if (stuck) continue;
-    core::FrequencyPoint q;
-    q.freq_hz = f;
-    q.value = p * Complex(1.0 + noise(rng), noise(rng));
-    q.amplitude = torque;
-    r.points.push_back(q);
-  }
+  const core::FrequencyResponse r = chain_sweep(
+      c, 31, SensorSide::kLoad, [](double f) { return 0.3 * (1.0 + 3.0 / f) * (1.0 + (f / 150.0) * (f / 150.0)); });
   FitOptions o = with_lag();
   o.sensor = SensorSide::kLoad;
   const FitReport linear = fit_plant(r, {ModelRequest::Kind::kModes, 2}, o);
