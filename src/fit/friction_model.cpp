@@ -134,20 +134,18 @@ std::vector<ModalPair> modal_pairs(const std::vector<Complex>& roots) {
   return pairs;
 }
 
-/// Polynomial in s² with the given roots −ω², times s when `odd`, coefficients highest first with
-/// the odd (even) powers' zeros explicit: the parity the continued fraction relies on.
+/// Coefficients (highest first) of Π(s² + ω²), times s when `odd`: core::Polynomial::from_roots of
+/// the pairs ±jω multiplies real quadratics s² + 0·s + ω², so the odd (even) powers' coefficients
+/// are exact zeros, the parity the continued fraction relies on.
 std::vector<double> even_polynomial(const std::vector<double>& omega, bool odd) {
-  std::vector<double> c{1.0};
+  std::vector<Complex> roots;
   for (double w : omega) {
-    std::vector<double> next(c.size() + 2, 0.0);
-    for (std::size_t i = 0; i < c.size(); ++i) {
-      next[i] += c[i];
-      next[i + 2] += c[i] * w * w;
-    }
-    c = std::move(next);
+    roots.emplace_back(0.0, w);
+    roots.emplace_back(0.0, -w);
   }
-  if (odd) c.push_back(0.0);
-  return c;
+  core::Polynomial p = core::Polynomial::from_roots(roots);
+  if (odd) p = p * core::Polynomial{1.0, 0.0};
+  return {p.coefficients().begin(), p.coefficients().end()};
 }
 
 }  // namespace
