@@ -1,7 +1,10 @@
-// AxisModel::simulate throughput. Target (issue): >= 10 M samples/s with friction switching, on
-// a thesis-like 22 s identification command at 1 kHz and on a 10-minute command, allocating only
-// the three output vectors. Baseline in the same run: core::simulate_zoh of the same linear
-// system (the generic ZOH simulator; no friction), reported for the ratio.
+// AxisModel::simulate throughput. Targets: >= 10 M samples/s with friction switching (first
+// issue), >= 50 M samples/s for every model with reused outputs (issue 26, including a model
+// faster than the sampling), on a thesis-like 22 s identification command at 1 kHz and on a
+// 10-minute command, allocating only the three output vectors. References in the same run:
+// core::simulate_zoh of the same linear system (the generic ZOH simulator; no friction), and the
+// simulation with the series event search on every sample (ModelSimulationOptions::
+// event_search_every_sample), which the certified single steps must equal.
 //
 // Commands: random back-and-forth trapezoidal moves (std::mt19937_64, seed 7): targets uniform in
 // [0, 100] mm, feeds uniform in [10, 200] mm/s, acceleration 2000 mm/s^2, dwells of 0-50 ms, so a
@@ -77,11 +80,23 @@ const ModelCoefficients kPid{.a1 = 192.65, .a2 = 44356.23, .a3 = 316830.21, .b0 
 const ModelCoefficients kPpi{.a1 = 372.76, .a2 = 62009.83, .a3 = 1527104.87, .b0 = 0.0, .b1 = 0.0,
                              .b2 = 11106.33, .d0 = 441.0, .d1 = -302.0};
 
+// A model faster than the sample rate at 1 kHz (issue 26: the 1 M-sample capture's fit): a pair at
+// 143 Hz with damping 0.2 and a real pole at 0.2 Hz, s^3 + a1 s^2 + a2 s + a3 =
+// (s + p)(s^2 + 2 zeta w s + w^2), PID structure (b2 = a2, b1 = 2 zeta w), the thesis's friction.
+ModelCoefficients fast_pair_model() {
+  const double w = 2.0 * 3.141592653589793 * 143.0, zeta = 0.2, p = 2.0 * 3.141592653589793 * 0.2;
+  return {.a1 = 2.0 * zeta * w + p, .a2 = w * w + 2.0 * zeta * w * p, .a3 = p * w * w, .b0 = 0.0,
+          .b1 = 2.0 * zeta * w, .b2 = w * w + 2.0 * zeta * w * p, .d0 = 441.0, .d1 = -302.0};
+}
+
 // reuse = false: simulate() allocates fresh outputs each call (page faults of fresh memory are
 // part of that cost); reuse = true: simulate_into() into the same ModelResponse (no allocation).
-void run_simulation(benchmark::State& state, const ModelCoefficients& coefficients, double seconds, bool reuse) {
+void run_simulation(benchmark::State& state, const ModelCoefficients& coefficients, double seconds, bool reuse,
+                    bool event_search_every_sample = false) {
   const std::vector<double> command = random_moves(seconds);
   const AxisModel model(coefficients, kTs);
+  servotwin::rapid::ModelSimulationOptions options;
+  options.event_search_every_sample = event_search_every_sample;
   ModelResponse kept;
   std::uint64_t reversals = 0;
   double allocations = 0.0;
@@ -90,11 +105,11 @@ void run_simulation(benchmark::State& state, const ModelCoefficients& coefficien
     const std::size_t before = malloc_calls;
 #endif
     if (reuse) {
-      model.simulate_into(command, kept);
+      model.simulate_into(command, kept, options);
       reversals = kept.events.reversals;
       benchmark::DoNotOptimize(kept.position.data());
     } else {
-      ModelResponse r = model.simulate(command);
+      ModelResponse r = model.simulate(command, options);
       reversals = r.events.reversals;
       benchmark::DoNotOptimize(r.position.data());
     }
@@ -116,6 +131,15 @@ void BM_SimulatePidFriction22s(benchmark::State& state) { run_simulation(state, 
 void BM_SimulatePidFriction22sReused(benchmark::State& state) { run_simulation(state, kPid, 22.0, true); }
 void BM_SimulatePpiFriction22sReused(benchmark::State& state) { run_simulation(state, kPpi, 22.0, true); }
 void BM_SimulatePidLinear22sReused(benchmark::State& state) { run_simulation(state, without_friction(kPid), 22.0, true); }
+void BM_SimulateFastPairFriction22sReused(benchmark::State& state) {
+  run_simulation(state, fast_pair_model(), 22.0, true);
+}
+// The reference the certified steps are tested against: the series event search on every sample
+// (what every sample of a model faster than the sampling cost before issue 26).
+void BM_SimulateFastPairFriction22sEverySample(benchmark::State& state) {
+  run_simulation(state, fast_pair_model(), 22.0, true, true);
+}
+void BM_SimulatePidFriction22sEverySample(benchmark::State& state) { run_simulation(state, kPid, 22.0, true, true); }
 void BM_SimulatePidFriction10min(benchmark::State& state) { run_simulation(state, kPid, 600.0, false); }
 void BM_SimulatePidFriction10minReused(benchmark::State& state) { run_simulation(state, kPid, 600.0, true); }
 
@@ -151,6 +175,9 @@ void BM_CoreSimulateZohBaseline22s(benchmark::State& state) {
 BENCHMARK(BM_SimulatePidFriction22s)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SimulatePidFriction22sReused)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SimulatePpiFriction22sReused)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SimulateFastPairFriction22sReused)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SimulateFastPairFriction22sEverySample)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SimulatePidFriction22sEverySample)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SimulatePidLinear22sReused)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_CoreSimulateZohBaseline22s)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SimulatePidFriction10min)->Unit(benchmark::kMillisecond);

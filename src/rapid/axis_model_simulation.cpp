@@ -7,9 +7,12 @@
 // is second-order accurate like a first-order hold and keeps the exact per-mode integration.
 // So in each friction mode the state z = (x, x', e_i)
 // follows the linear system z' = A z + b with constant b. A whole sample is one step with the
-// precomputed zero-order-hold matrices. When the velocity may reach zero inside the sample, the
-// sample is redone on the exact solution written as the power series of the sub-step's matrix
-// exponential, exp(M s) [z0; 1] = sum_k s^k/k! M^k [z0; 1], in scaled coordinates
+// precomputed zero-order-hold matrices, taken whenever the velocity provably keeps its sign through
+// the sample: by the end-point tangents on models slower than the sampling, and for any model by
+// the modal bound of velocity_sign_bound.hpp (issue 26: a model faster than the sampling used to
+// take the series below on every sample, 1-3 M samples/s). Otherwise the sample is redone on
+// the exact solution written as the power series of the sub-step's matrix exponential,
+// exp(M s) [z0; 1] = sum_k s^k/k! M^k [z0; 1], in scaled coordinates
 //   xi = (x, x' T, e_i / T),  sigma = t / T  (T = ts),
 // where M has entries of order (omega T), so 20 terms reach double precision on a piece of
 // length 1/||M||. The velocity is then a polynomial in sigma: the first zero crossing is found by
@@ -24,6 +27,7 @@
 
 #include "servotwin/core/error.hpp"
 #include "servotwin/rapid/axis_model.hpp"
+#include "velocity_sign_bound.hpp"
 
 namespace servotwin::rapid {
 
@@ -59,6 +63,16 @@ struct Series {
     for (int k = kTerms - 2; k >= 1; --k) r = r * s + static_cast<double>(k) * v[static_cast<std::size_t>(k)];
     return r;
   }
+  // The velocity and its derivative in one Horner pass (the scan and Newton need both).
+  void velocity_and_slope(double s, double& value, double& slope) const {
+    double r = v[kTerms - 1], d = 0.0;
+    for (int k = kTerms - 2; k >= 0; --k) {
+      d = d * s + r;
+      r = r * s + v[static_cast<std::size_t>(k)];
+    }
+    value = r;
+    slope = d;
+  }
   [[nodiscard]] static double horner(const std::array<double, kTerms>& c, double s) {
     double r = c[kTerms - 1];
     for (int k = kTerms - 2; k >= 0; --k) r = r * s + c[static_cast<std::size_t>(k)];
@@ -69,8 +83,8 @@ struct Series {
 // Everything one simulation needs, derived from the model once per call.
 class Integrator {
  public:
-  Integrator(const ModelCoefficients& c, double ts, const AxisModel::Kernel& kernel)
-      : c_(c), t_(ts), k_(kernel) {
+  Integrator(const ModelCoefficients& c, double ts, const AxisModel::Kernel& kernel, bool every_sample)
+      : c_(c), t_(ts), k_(kernel), bound_(c.a1, c.a2, c.a3, ts), every_sample_(every_sample) {
     a21_ = c.a2 * ts * ts;
     a11_ = c.a1 * ts;
     a31_ = c.a3 * ts * ts * ts;
@@ -89,14 +103,14 @@ class Integrator {
 
   // One sample with friction switching.
   void step(State& s, double xr, double w, SimulationEvents& events) const {
-    // The quick test below bounds the velocity by its end-point tangents, which is only sound
-    // when the velocity is close to a parabola within the sample: for dynamics faster than the
-    // sample rate (||M|| > 1, a series piece shorter than the sample) every sample is examined.
-    if (s.mode != Mode::Stuck && s.v != 0.0 && piece_ >= 1.0) {
+    if (s.mode != Mode::Stuck && s.v != 0.0 && !every_sample_) {
       State next = s;
-      const double f = friction(s.mode);
-      step_linear(next, xr, w - f);
-      if (!crossing_possible(s, next, w - f)) {
+      const double drive = w - friction(s.mode);
+      step_linear(next, xr, drive);
+      // The tangent test bounds the velocity by its end-point tangents, which is only sound when
+      // the velocity is close to a parabola within the sample (||M|| <= 1); the modal bound holds
+      // for any model, faster than the sample rate too (velocity_sign_bound.hpp).
+      if ((piece_ >= 1.0 && !crossing_possible(s, next, drive)) || keeps_sign(s, xr, drive)) {
         s = next;
         return;
       }
@@ -106,6 +120,14 @@ class Integrator {
 
  private:
   [[nodiscard]] double friction(Mode m) const { return m == Mode::Plus ? c_.d0 : c_.d1; }
+
+  // Certified sign of the velocity over the whole sample from the state at its start.
+  [[nodiscard]] bool keeps_sign(const State& s, double xr, double drive) const {
+    if (!bound_.usable()) return false;
+    const double acceleration = -c_.a2 * s.x - c_.a1 * s.v + c_.a3 * s.ei + drive;
+    const double jerk = -c_.a2 * s.v - c_.a1 * acceleration + c_.a3 * (xr - s.x);
+    return bound_.keeps_sign(sign_of(s.mode), s.v, acceleration * t_, jerk * t_ * t_);
+  }
   [[nodiscard]] double net_drive(const State& s, double w) const { return -c_.a2 * s.x + c_.a3 * s.ei + w; }
 
   // Rounding level of a velocity computed from this state [length/s]: the accelerations that
@@ -188,10 +210,12 @@ class Integrator {
     double x = 0.5 * (lo + hi);
     double last_width = hi - lo;
     for (int it = 0; it < 100; ++it) {
-      const double h = dir * series.velocity(x) + tol;
+      double value = 0.0, slope = 0.0;
+      series.velocity_and_slope(x, value, slope);
+      const double h = dir * value + tol;
       (h >= 0.0 ? lo : hi) = x;
       if (hi - lo <= 4.0 * kEps * hi) break;
-      const double dh = dir * series.acceleration(x);
+      const double dh = dir * slope;
       const double newton = dh != 0.0 ? x - h / dh : lo;
       const double width = hi - lo;
       if (newton > lo && newton < hi && width < 0.5 * last_width + 8.0 * kEps * hi) {
@@ -215,9 +239,11 @@ class Integrator {
     double slope_prev = dir * series.v[1];
     for (int j = 1; j <= kScanPoints; ++j) {
       const double s = length * static_cast<double>(j) / kScanPoints;
-      const double h = dir * series.velocity(s) + tol;
+      double value = 0.0, derivative = 0.0;
+      series.velocity_and_slope(s, value, derivative);
+      const double h = dir * value + tol;
       if (h < 0.0) return refine(series, dir, tol, s_prev, s);
-      const double slope = dir * series.acceleration(s);
+      const double slope = dir * derivative;
       if (slope_prev < 0.0 && slope > 0.0) {
         double lo = s_prev, hi = s;  // bisection on the slope for the minimum
         for (int it = 0; it < 60 && hi - lo > 4.0 * kEps * hi; ++it) {
@@ -308,10 +334,31 @@ class Integrator {
   ModelCoefficients c_;
   double t_;
   AxisModel::Kernel k_;
+  detail::VelocitySignBound bound_;
+  bool every_sample_ = false;
   double a21_ = 0.0, a11_ = 0.0, a31_ = 0.0;  // a2 T^2, a1 T, a3 T^3
   double piece_ = 1.0;
   double friction_max_ = 0.0;
 };
+
+// The event search integrates a sample in series pieces of length 1/||M|| (||M|| = a2 ts^2 +
+// a1 ts + a3 ts^3, the model's speed against the sampling): a model a million times faster than
+// its sampling would need a million pieces for every sample with a friction event (issue 26: a
+// fit scaled by 1e6 ran for minutes on a 1.3 s program). Such a model is refused; kMaxPieces
+// keeps an event sample under a few milliseconds.
+constexpr double kMaxPieces = 4096.0;
+
+void require_bounded_event_search(const ModelCoefficients& c, double ts) {
+  const double speed = std::abs(c.a2) * ts * ts + std::abs(c.a1) * ts + std::abs(c.a3) * ts * ts * ts;
+  if (!(speed <= kMaxPieces)) {
+    throw core::InputError(core::at_field("a1"),
+                           "the model's dynamics are " + std::to_string(static_cast<long long>(std::min(speed, 1e18))) +
+                               " times faster than its sample period (a2 ts^2 + a1 ts + a3 ts^3; at most " +
+                               std::to_string(static_cast<int>(kMaxPieces)) +
+                               " can be simulated with friction): poles this far beyond Nyquist cannot come from "
+                               "data sampled at this rate; check the coefficients' units and the sample period");
+  }
+}
 
 }  // namespace
 
@@ -336,6 +383,7 @@ void AxisModel::simulate_into(std::span<const double> command, ModelResponse& ou
     throw core::InputError(core::at_field("ts"), "the model grows by more than exp(700) within one sample period; "
                                         "its zero-order-hold matrices overflow");
   }
+  if (c_.d0 != c_.d1) require_bounded_event_search(c_, ts_);
   out.position.resize(n);
   out.velocity.resize(n);
   out.tracking_error.resize(n);
@@ -354,7 +402,7 @@ void AxisModel::simulate_into(std::span<const double> command, ModelResponse& ou
   const double rest = (c.a3 == 0.0 && c.a2 != 0.0) ? c.b2 / c.a2 * u(0) : u(0);
   s.x = options.initial_position.value_or(rest);
   s.ei = options.initial_integrator.value_or(c.a3 != 0.0 ? (c.a2 * s.x - c.b2 * u(0)) / c.a3 : 0.0);
-  const Integrator integrator(c_, ts_, kernel_);
+  const Integrator integrator(c_, ts_, kernel_, options.event_search_every_sample);
   const bool switching = c.d0 != c.d1;
 
   // Sliding window u(k-2) .. u(k+3) of the padded, shifted command: one clamped load per sample.

@@ -351,6 +351,39 @@ TEST(AxisModelSimulation, BadInputAndDegenerateCases) {
   EXPECT_THROW((void)exploding.simulate(std::vector<double>(5, 0.0)), core::InputError);
 }
 
+TEST(AxisModelSimulation, ModelsFarBeyondNyquistAreRefusedWithFrictionAndSimulatedWithout) {
+  // Issue 26: the thesis's PID model scaled by 1e6 (a1 ts = 1.9e5: the event search would need
+  // that many series pieces per friction event) made predict run for minutes. With friction it is
+  // refused, naming a1 and the speed; without friction it is a plain ZOH simulation. Scaled by
+  // 1e4 (a2 ts^2 + a1 ts + a3 ts^3 = 2.4e3) it is still simulated, in bounded time.
+  ModelCoefficients c = reference_model("pid_x_actual");
+  for (double* a : {&c.a1, &c.a2, &c.a3, &c.b0, &c.b1, &c.b2, &c.d0, &c.d1}) *a *= 1e6;
+  std::vector<double> circle;
+  for (int k = 0; k < 1300; ++k) circle.push_back(10.0 * std::sin(2.0 * std::numbers::pi * k / 1300.0));
+  try {
+    (void)AxisModel(c, kTs).simulate(circle);
+    FAIL() << "expected InputError";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.where().field, "a1");
+    EXPECT_NE(std::string(e.what()).find("times faster than its sample period"), std::string::npos) << e.what();
+  }
+  c.d0 = c.d1 = 0.0;
+  EXPECT_EQ(AxisModel(c, kTs).simulate(circle).position.size(), circle.size());
+  ModelCoefficients moderate = reference_model("pid_x_actual");
+  for (double* a : {&moderate.a1, &moderate.a2, &moderate.a3, &moderate.b0, &moderate.b1, &moderate.b2, &moderate.d0,
+                    &moderate.d1})
+    *a *= 1e4;
+  const ModelResponse r = AxisModel(moderate, kTs).simulate(circle);
+  EXPECT_GE(r.events.reversals, 1u);
+  ModelSimulationOptions every_sample;
+  every_sample.event_search_every_sample = true;
+  const ModelResponse ref = AxisModel(moderate, kTs).simulate(circle, every_sample);
+  double rms = 0.0;
+  for (double e : ref.tracking_error) rms += e * e;
+  rms = std::sqrt(rms / static_cast<double>(circle.size()));
+  for (std::size_t k = 0; k < circle.size(); ++k) EXPECT_NEAR(r.tracking_error[k], ref.tracking_error[k], 1e-9 * rms) << k;
+}
+
 }  // namespace axis_model_simulation_test
 }  // namespace
 }  // namespace servotwin::rapid

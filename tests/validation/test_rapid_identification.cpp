@@ -107,6 +107,32 @@ TEST_P(PresetIdentification, SearchedShiftPredictsAtLeastAsWellAsTheControllersP
   ASSERT_EQ(searched.identification.shift_trials.size(), 7u);
 }
 
+TEST_P(PresetIdentification, FastSimulationEqualsTheEventSearchOnEverySample) {
+  // Issue 26: the certified single-step samples of AxisModel::simulate against the reference that
+  // runs the series event search on every sample, on each virtual machine's identified model and
+  // another program of the identification kind (seed 11); bound 1e-9 of the tracking error's RMS.
+  const machine::MachineConfig machine = machine::preset(GetParam().machine);
+  const auto identified = vcnc::identify_axis({thesis_capture(machine, 7)}, {}, "x", searched_shift());
+  const rapid::AxisModel model(identified.coefficients(), machine.ts);
+  const vcnc::NamedCapture other = thesis_capture(machine, 11);
+  const core::AxisTrace& trace = *other.capture.find("x");
+  rapid::ModelSimulationOptions fast, reference;
+  fast.command_shift = reference.command_shift = identified.regressors.command_shift;
+  reference.event_search_every_sample = true;
+  const rapid::ModelResponse a = model.simulate(trace.cmd, fast);
+  const rapid::ModelResponse b = model.simulate(trace.cmd, reference);
+  double rms = 0.0;
+  for (double e : b.tracking_error) rms += e * e;
+  rms = std::sqrt(rms / static_cast<double>(b.tracking_error.size()));
+  ASSERT_GT(rms, 0.0);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < a.tracking_error.size(); ++k) worst = std::max(worst, std::abs(a.tracking_error[k] - b.tracking_error[k]));
+  EXPECT_LE(worst, 1e-9 * rms);
+  EXPECT_EQ(a.events.reversals, b.events.reversals);
+  EXPECT_EQ(a.events.sticks, b.events.sticks);
+  EXPECT_GT(a.events.reversals, 0u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Presets, PresetIdentification,
                          ::testing::Values(Case{"fadal-ppi", 0.08, 0.10}, Case{"fadal-pid", 0.03, 0.10},
                                            Case{"fadal-smc", 0.05, 0.23}, Case{"ballscrew-zpetc", 0.01, 0.30}),

@@ -55,6 +55,11 @@ struct ModelSimulationOptions {
   /// x(0) = x_r,0 this is 0; for the P-PI structure (b2 != a2) an integrator starting at 0 would
   /// start the model away from equilibrium.
   std::optional<double> initial_integrator;
+  /// Examine every sample with the exact event search (the series of the matrix exponential)
+  /// instead of first certifying that the velocity keeps its sign through the sample: the
+  /// reference the fast path is tested and benchmarked against (tens of times slower on models
+  /// faster than the sample rate). Results agree to rounding.
+  bool event_search_every_sample = false;
 };
 
 /// Event counts of one simulation (friction switching).
