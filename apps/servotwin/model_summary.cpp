@@ -79,7 +79,8 @@ void print_model_summary(const vcnc::AxisIdentification& r) {
   fmt::print("  {}; {}\n", model.is_stable() ? "stable" : "UNSTABLE", bandwidth_text(model));
   if (!r.shift_trials.empty()) {
     fmt::print("  command shift {} samples, chosen by fit from:", r.regressors.command_shift);
-    for (const auto& t : r.shift_trials) fmt::print(" {}:{:.4f}{}", t.shift, t.nrmse, t.stable ? "" : "(unstable)");
+    for (const auto& t : r.shift_trials)
+      fmt::print(" {}:{}{:.4f}{}", t.shift, t.complete ? "" : ">", t.nrmse, t.stable ? "" : "(unstable)");
     fmt::print("\n");
   } else if (r.regressors.command_shift != 0) {
     fmt::print("  command shift {} samples\n", r.regressors.command_shift);

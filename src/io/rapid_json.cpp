@@ -233,7 +233,10 @@ json axis_model_to_json(const vcnc::AxisIdentification& record) {
       {"sources", record.sources}};
   if (!record.shift_trials.empty()) {
     json trials = json::array();
-    for (const auto& t : record.shift_trials) trials.push_back({{"shift", t.shift}, {"nrmse", t.nrmse}, {"stable", t.stable}});
+    // complete = false: the candidate's simulation stopped once it could not be chosen, and
+    // nrmse is a lower bound.
+    for (const auto& t : record.shift_trials)
+      trials.push_back({{"shift", t.shift}, {"nrmse", t.nrmse}, {"stable", t.stable}, {"complete", t.complete}});
     doc["shift_search"] = trials;
   }
   if (record.refinement) doc["refinement"] = refinement_to_json(record);

@@ -114,21 +114,113 @@ void set_reading_quantum(FitMetrics& fit, double quantum) {
 
 FitMetrics simulation_fit(const AxisModel& model, std::span<const double> command, std::span<const double> actual,
                           const ModelSimulationOptions& options) {
-  if (command.size() != actual.size()) {
-    throw core::InputError(core::at_field("actual"), "length " + std::to_string(actual.size()) + " differs from the command's " +
-                                                std::to_string(command.size()));
+  const TrackingRecord record{command, actual};
+  return simulation_fit(model, std::span<const TrackingRecord>(&record, 1), options);
+}
+
+namespace {
+
+// compare_tracking's running norms, fed block by block from the simulation (same order, so the
+// same numbers).
+struct RunningComparison {
+  Norm measured, predicted, difference;
+  double max_difference = 0.0;
+  std::size_t offset = 0;  // samples of the records before the current one
+};
+
+class ComparisonSink final : public PositionSink {
+ public:
+  ComparisonSink(const TrackingRecord& record, RunningComparison& sums, double give_up_norm)
+      : record_(record), sums_(sums), give_up_norm_(give_up_norm) {}
+
+  bool consume(std::size_t first, std::span<const double> positions) override {
+    for (std::size_t j = 0; j < positions.size(); ++j) {
+      const std::size_t k = first + j;
+      const double measured = record_.command[k] - record_.actual[k];
+      const double predicted = record_.command[k] - positions[j];
+      if (!std::isfinite(predicted)) {
+        throw core::InputError(core::at_field("predicted_error[" + std::to_string(sums_.offset + k) + "]"),
+                               "tracking error sample must be finite (an unstable model's prediction diverges)");
+      }
+      const double d = measured - predicted;
+      sums_.measured.add(measured);
+      sums_.predicted.add(predicted);
+      sums_.difference.add(d);
+      sums_.max_difference = std::max(sums_.max_difference, std::abs(d));
+    }
+    gave_up_ = sums_.difference.value() > give_up_norm_;
+    return !gave_up_;
   }
-  if (command.empty()) throw core::InputError(core::at_field("command"), "at least one sample is required");
-  for (std::size_t k = 0; k < actual.size(); ++k) {
-    if (!std::isfinite(actual[k]))
-      throw core::InputError(core::at_field("actual[" + std::to_string(k) + "]"), "actual position sample must be finite");
+  [[nodiscard]] bool gave_up() const { return gave_up_; }
+
+ private:
+  const TrackingRecord& record_;
+  RunningComparison& sums_;
+  double give_up_norm_;
+  bool gave_up_ = false;
+};
+
+}  // namespace
+
+FitMetrics simulation_fit(const AxisModel& model, std::span<const TrackingRecord> records,
+                          const ModelSimulationOptions& options, double give_up_above) {
+  // First pass over the data alone: nrmse's scale, the spread of the measured error.
+  std::size_t n = 0;
+  double sum = 0.0;
+  for (const TrackingRecord& r : records) {
+    if (r.command.size() != r.actual.size()) {
+      throw core::InputError(core::at_field("actual"), "length " + std::to_string(r.actual.size()) +
+                                                  " differs from the command's " + std::to_string(r.command.size()));
+    }
+    if (r.command.empty()) throw core::InputError(core::at_field("command"), "at least one sample is required");
+    for (std::size_t k = 0; k < r.actual.size(); ++k) {
+      if (!std::isfinite(r.actual[k]))
+        throw core::InputError(core::at_field("actual[" + std::to_string(n + k) + "]"), "actual position sample must be finite");
+      sum += r.command[k] - r.actual[k];
+    }
+    n += r.command.size();
   }
-  ModelSimulationOptions opts = options;
-  if (!opts.initial_position) opts.initial_position = actual.front();
-  const ModelResponse response = model.simulate(command, opts);
-  std::vector<double> measured(command.size());
-  for (std::size_t k = 0; k < command.size(); ++k) measured[k] = command[k] - actual[k];
-  return compare_tracking(measured, response.tracking_error);
+  if (n == 0) throw core::InputError(core::at_field("command"), "at least one sample is required");
+  const double count = static_cast<double>(n);
+  const double mean = sum / count;
+  Norm deviation;
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+  for (const TrackingRecord& r : records) {
+    for (std::size_t k = 0; k < r.command.size(); ++k) {
+      const double e = r.command[k] - r.actual[k];
+      deviation.add(e - mean);
+      lowest = std::min(lowest, e);
+      highest = std::max(highest, e);
+    }
+  }
+  const bool constant = lowest == highest;
+  // A constant measured error has no spread to scale by: never give up then.
+  const double give_up_norm = constant ? std::numeric_limits<double>::infinity() : give_up_above * deviation.value();
+
+  RunningComparison sums;
+  bool gave_up = false;
+  for (const TrackingRecord& r : records) {
+    ModelSimulationOptions o = options;
+    if (!o.initial_position) o.initial_position = r.actual.front();
+    ComparisonSink sink(r, sums, give_up_norm);
+    (void)model.simulate_blocks(r.command, o, sink);
+    sums.offset += r.command.size();
+    if ((gave_up = sink.gave_up())) break;
+  }
+
+  FitMetrics m;
+  const double root_n = std::sqrt(count);
+  m.samples = n;
+  m.complete = !gave_up;
+  m.rms_measured = sums.measured.value() / root_n;
+  m.rms_predicted = sums.predicted.value() / root_n;
+  m.rms_difference = sums.difference.value() / root_n;
+  m.max_difference = sums.max_difference;
+  if (constant) m.nrmse = sums.difference.value() == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();
+  else m.nrmse = sums.difference.value() / deviation.value();
+  m.fit_percent = 100.0 * (1.0 - m.nrmse);
+  m.std_measured = deviation.value() / root_n;
+  return m;
 }
 
 }  // namespace servotwin::rapid

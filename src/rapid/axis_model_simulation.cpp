@@ -360,18 +360,9 @@ void require_bounded_event_search(const ModelCoefficients& c, double ts) {
   }
 }
 
-}  // namespace
-
-ModelResponse AxisModel::simulate(std::span<const double> command, const ModelSimulationOptions& options) const {
-  ModelResponse out;
-  simulate_into(command, out, options);
-  return out;
-}
-
-void AxisModel::simulate_into(std::span<const double> command, ModelResponse& out,
-                              const ModelSimulationOptions& options) const {
-  const std::size_t n = command.size();
-  for (std::size_t k = 0; k < n; ++k) {
+void require_simulable(std::span<const double> command, const ModelSimulationOptions& options,
+                       const ModelCoefficients& c, double ts, const AxisModel::Kernel& kernel) {
+  for (std::size_t k = 0; k < command.size(); ++k) {
     if (!std::isfinite(command[k]))
       throw core::InputError(core::at_field("command[" + std::to_string(k) + "]"), "command sample must be finite");
   }
@@ -379,30 +370,32 @@ void AxisModel::simulate_into(std::span<const double> command, ModelResponse& ou
     throw core::InputError(core::at_field("initial_position"), "must be finite");
   if (options.initial_integrator && !std::isfinite(*options.initial_integrator))
     throw core::InputError(core::at_field("initial_integrator"), "must be finite");
-  if (!kernel_.valid) {
+  if (!kernel.valid) {
     throw core::InputError(core::at_field("ts"), "the model grows by more than exp(700) within one sample period; "
                                         "its zero-order-hold matrices overflow");
   }
-  if (c_.d0 != c_.d1) require_bounded_event_search(c_, ts_);
-  out.position.resize(n);
-  out.velocity.resize(n);
-  out.tracking_error.resize(n);
-  out.events = SimulationEvents{};
-  if (n == 0) return;
+  if (c.d0 != c.d1) require_bounded_event_search(c, ts);
+}
 
+// The simulation loop shared by simulate_into and simulate_blocks: emit(k, x_k, x'_k) receives
+// every output sample and returns false to stop. Returns the number of samples emitted.
+template <typename Emit>
+std::size_t run(std::span<const double> command, const ModelSimulationOptions& options, const ModelCoefficients& c,
+                double ts, const AxisModel::Kernel& kernel, SimulationEvents& events, Emit&& emit) {
+  const std::size_t n = command.size();
+  if (n == 0) return 0;
   // The driving command, extended by its end values (clamped index) and shifted.
   const auto last = static_cast<std::ptrdiff_t>(n) - 1;
   const std::ptrdiff_t shift = options.command_shift;
   const auto u = [&](std::ptrdiff_t j) { return command[static_cast<std::size_t>(std::clamp(j + shift, std::ptrdiff_t{0}, last))]; };
-  const double inv2t = 1.0 / (2.0 * ts_);
-  const ModelCoefficients& c = c_;
+  const double inv2t = 1.0 / (2.0 * ts);
 
   State s;
   // Default start: at rest under the first command (x = x_r,0, or b2/a2 x_r,0 without integrator).
   const double rest = (c.a3 == 0.0 && c.a2 != 0.0) ? c.b2 / c.a2 * u(0) : u(0);
   s.x = options.initial_position.value_or(rest);
   s.ei = options.initial_integrator.value_or(c.a3 != 0.0 ? (c.a2 * s.x - c.b2 * u(0)) / c.a3 : 0.0);
-  const Integrator integrator(c_, ts_, kernel_, options.event_search_every_sample);
+  const Integrator integrator(c, ts, kernel, options.event_search_every_sample);
   const bool switching = c.d0 != c.d1;
 
   // Sliding window u(k-2) .. u(k+3) of the padded, shifted command: one clamped load per sample.
@@ -410,9 +403,7 @@ void AxisModel::simulate_into(std::span<const double> command, ModelResponse& ou
   const double inv4t2 = inv2t * inv2t;
   for (std::ptrdiff_t k = 0; k <= last; ++k) {
     const auto i = static_cast<std::size_t>(k);
-    out.position[i] = s.x;
-    out.velocity[i] = s.v;
-    out.tracking_error[i] = command[i] - s.x;
+    if (!emit(i, s.x, s.v)) return i + 1;
     if (k == last) break;  // the step after the last sample would produce no output
     // Central differences at k and k+1 (x_r'_j = (x_r,j+1 - x_r,j-1)/(2 ts), x_r''_j = (x_r'_j+1 -
     // x_r'_j-1)/(2 ts)), then their mean: the held values of the sample's midpoint.
@@ -426,9 +417,56 @@ void AxisModel::simulate_into(std::span<const double> command, ModelResponse& ou
     up1 = up2;
     up2 = up3;
     up3 = u(k + 4);
-    if (switching) integrator.step(s, xr, w, out.events);
+    if (switching) integrator.step(s, xr, w, events);
     else integrator.step_linear(s, xr, w - c.d0);
   }
+  return n;
+}
+
+}  // namespace
+
+ModelResponse AxisModel::simulate(std::span<const double> command, const ModelSimulationOptions& options) const {
+  ModelResponse out;
+  simulate_into(command, out, options);
+  return out;
+}
+
+void AxisModel::simulate_into(std::span<const double> command, ModelResponse& out,
+                              const ModelSimulationOptions& options) const {
+  require_simulable(command, options, c_, ts_, kernel_);
+  const std::size_t n = command.size();
+  out.position.resize(n);
+  out.velocity.resize(n);
+  out.tracking_error.resize(n);
+  out.events = SimulationEvents{};
+  double* position = out.position.data();
+  double* velocity = out.velocity.data();
+  double* error = out.tracking_error.data();
+  run(command, options, c_, ts_, kernel_, out.events, [&](std::size_t i, double x, double v) {
+    position[i] = x;
+    velocity[i] = v;
+    error[i] = command[i] - x;
+    return true;
+  });
+}
+
+std::size_t AxisModel::simulate_blocks(std::span<const double> command, const ModelSimulationOptions& options,
+                                       PositionSink& sink) const {
+  require_simulable(command, options, c_, ts_, kernel_);
+  std::array<double, kSimulationBlock> block;
+  std::size_t first = 0, filled = 0;
+  bool go_on = true;
+  SimulationEvents events;
+  const std::size_t done = run(command, options, c_, ts_, kernel_, events, [&](std::size_t, double x, double) {
+    block[filled++] = x;
+    if (filled < block.size()) return true;
+    go_on = sink.consume(first, std::span<const double>(block.data(), filled));
+    first += filled;
+    filled = 0;
+    return go_on;
+  });
+  if (go_on && filled > 0) sink.consume(first, std::span<const double>(block.data(), filled));
+  return done;
 }
 
 }  // namespace servotwin::rapid

@@ -222,10 +222,11 @@ Section model_section(const vcnc::AxisIdentification& id, const rapid::AxisModel
 
   if (!id.shift_trials.empty()) {
     Table trials;
-    trials.title = "Command shift search (NRMSE of the simulated tracking error on the identification data)";
+    trials.title = "Command shift search (NRMSE of the simulated tracking error on the identification data; "
+                   "\"> x\": simulation stopped once the shift could no longer be chosen)";
     trials.header = {"shift [samples]", "NRMSE", "stable", "chosen"};
     for (const auto& t : id.shift_trials)
-      trials.rows.push_back({std::to_string(t.shift), num(t.nrmse, 5), t.stable ? "yes" : "no",
+      trials.rows.push_back({std::to_string(t.shift), (t.complete ? "" : "> ") + num(t.nrmse, 5), t.stable ? "yes" : "no",
                              t.shift == id.regressors.command_shift ? "yes" : ""});
     s.tables.push_back(std::move(trials));
   }

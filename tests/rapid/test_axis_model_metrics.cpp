@@ -113,6 +113,43 @@ TEST(AxisModelMetrics, SimulationFitOnIdentificationAndValidationCaptures) {
   }
 }
 
+TEST(AxisModelMetrics, PooledRecordsAndTheGiveUpBound) {
+  // Two records compared as one sequence give compare_tracking's numbers on the concatenated
+  // errors (each record simulated from its own first actual position); with a give-up bound below
+  // the true nrmse the simulation stops early with a lower bound above the give-up level, and with
+  // one above it the result is complete and unchanged.
+  const AxisModel truth(test::reference_model("pid_x_actual"), kTs);
+  const AxisModel estimate(test::reference_model("pid_x_estimated"), kTs);
+  const std::vector<double> first = test::back_and_forth(8.0, 120.0, 1500.0, kTs, 0.1, 3);
+  const std::vector<double> second = test::back_and_forth(3.0, 60.0, 800.0, kTs, 0.05, 4);
+  const std::vector<double> act1 = truth.simulate(first).position, act2 = truth.simulate(second).position;
+  std::vector<double> measured, predicted;
+  for (const auto& [cmd, act] : {std::pair{&first, &act1}, std::pair{&second, &act2}}) {
+    ModelSimulationOptions o;
+    o.initial_position = act->front();
+    const ModelResponse r = estimate.simulate(*cmd, o);
+    for (std::size_t k = 0; k < cmd->size(); ++k) measured.push_back((*cmd)[k] - (*act)[k]);
+    predicted.insert(predicted.end(), r.tracking_error.begin(), r.tracking_error.end());
+  }
+  const FitMetrics by_hand = compare_tracking(measured, predicted);
+  const std::vector<TrackingRecord> records{{first, act1}, {second, act2}};
+  const FitMetrics pooled = simulation_fit(estimate, records, {});
+  EXPECT_TRUE(pooled.complete);
+  EXPECT_EQ(pooled.nrmse, by_hand.nrmse);
+  EXPECT_EQ(pooled.rms_predicted, by_hand.rms_predicted);
+  EXPECT_EQ(pooled.max_difference, by_hand.max_difference);
+  EXPECT_EQ(pooled.std_measured, by_hand.std_measured);
+  EXPECT_EQ(pooled.samples, measured.size());
+
+  const FitMetrics stopped = simulation_fit(estimate, records, {}, 0.5 * by_hand.nrmse);
+  EXPECT_FALSE(stopped.complete);
+  EXPECT_GT(stopped.nrmse, 0.5 * by_hand.nrmse);
+  EXPECT_LE(stopped.nrmse, by_hand.nrmse);
+  const FitMetrics kept = simulation_fit(estimate, records, {}, 1.01 * by_hand.nrmse);
+  EXPECT_TRUE(kept.complete);
+  EXPECT_EQ(kept.nrmse, by_hand.nrmse);
+}
+
 /// A slow sine sampled at 1 kHz: positions that pass every count of a grid many times.
 std::vector<double> sine_positions(double amplitude, double offset) {
   std::vector<double> x(5000);

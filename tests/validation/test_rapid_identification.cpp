@@ -107,6 +107,50 @@ TEST_P(PresetIdentification, SearchedShiftPredictsAtLeastAsWellAsTheControllersP
   ASSERT_EQ(searched.identification.shift_trials.size(), 7u);
 }
 
+TEST_P(PresetIdentification, StoppedShiftCandidatesChangeNoChoice) {
+  // Issue 26: the shift search stops a candidate's simulation once it can no longer be chosen.
+  // Reference: every shift identified on its own with its complete fit, and choose_shift's rule
+  // (identification.cpp) applied by hand: the stable models, those within 2 % of the best nrmse,
+  // the smallest |shift| among them (ties: the lower nrmse).
+  const machine::MachineConfig machine = machine::preset(GetParam().machine);
+  const vcnc::NamedCapture capture = thesis_capture(machine, 7);
+  const auto searched = vcnc::identify_axis({capture}, {}, "x", searched_shift());
+  std::vector<vcnc::AxisIdentification> each;
+  for (int shift = -3; shift <= 3; ++shift) {
+    vcnc::IdentificationSettings fixed;
+    fixed.regressors.command_shift = shift;
+    each.push_back(vcnc::identify_axis({capture}, {}, "x", fixed));
+  }
+  double best = std::numeric_limits<double>::infinity();
+  bool any_stable = false;
+  for (const auto& e : each) any_stable = any_stable || rapid::AxisModel(e.coefficients(), e.ts).is_stable();
+  for (const auto& e : each)
+    if (rapid::AxisModel(e.coefficients(), e.ts).is_stable() == any_stable) best = std::min(best, e.fit->nrmse);
+  const vcnc::AxisIdentification* chosen = nullptr;
+  for (const auto& e : each) {
+    if (rapid::AxisModel(e.coefficients(), e.ts).is_stable() != any_stable || e.fit->nrmse > best * 1.02) continue;
+    const int s = e.regressors.command_shift;
+    if (chosen == nullptr || std::abs(s) < std::abs(chosen->regressors.command_shift) ||
+        (std::abs(s) == std::abs(chosen->regressors.command_shift) && e.fit->nrmse < chosen->fit->nrmse))
+      chosen = &e;
+  }
+  ASSERT_NE(chosen, nullptr);
+  EXPECT_EQ(searched.regressors.command_shift, chosen->regressors.command_shift);
+  EXPECT_EQ(searched.coefficients().a1, chosen->coefficients().a1);
+  EXPECT_EQ(searched.coefficients().d1, chosen->coefficients().d1);
+  EXPECT_EQ(searched.fit->nrmse, chosen->fit->nrmse);
+  ASSERT_EQ(searched.shift_trials.size(), each.size());
+  for (std::size_t i = 0; i < each.size(); ++i) {
+    const vcnc::ShiftTrial& t = searched.shift_trials[i];
+    if (t.complete) {
+      EXPECT_EQ(t.nrmse, each[i].fit->nrmse) << t.shift;
+    } else {
+      EXPECT_LE(t.nrmse, each[i].fit->nrmse) << t.shift;       // a lower bound
+      EXPECT_GT(each[i].fit->nrmse, best * 1.02) << t.shift;  // and rightly out of the running
+    }
+  }
+}
+
 TEST_P(PresetIdentification, FastSimulationEqualsTheEventSearchOnEverySample) {
   // Issue 26: the certified single-step samples of AxisModel::simulate against the reference that
   // runs the series event search on every sample, on each virtual machine's identified model and

@@ -20,6 +20,7 @@
 
 #include <complex>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <vector>
@@ -81,11 +82,27 @@ struct ModelResponse {
   SimulationEvents events;
 };
 
+/// Receives a simulation's positions block by block (AxisModel::simulate_blocks).
+class PositionSink {
+ public:
+  virtual ~PositionSink() = default;
+  /// Positions x_k for k = first, first + 1, ...; false stops the simulation.
+  virtual bool consume(std::size_t first, std::span<const double> positions) = 0;
+};
+
+/// A measured tracking record: the command and the actual position of one axis, sample by sample.
+struct TrackingRecord {
+  std::span<const double> command;
+  std::span<const double> actual;
+};
+
 /// Eq. 3.3 with its sample period.
 class AxisModel {
  public:
   /// Maximum number of friction events (zero crossings, sticks, breakaways) located per sample.
   static constexpr int kMaxEventsPerSample = 32;
+  /// Samples per block of simulate_blocks.
+  static constexpr std::size_t kSimulationBlock = 1024;
 
   /// core::InputError (field "a1".."d1" or "ts") for non-finite coefficients or ts not finite > 0.
   AxisModel(const ModelCoefficients& coefficients, double ts);
@@ -150,6 +167,12 @@ class AxisModel {
   /// model's growth over one sample exceeds the double range.
   [[nodiscard]] ModelResponse simulate(std::span<const double> command,
                                        const ModelSimulationOptions& options = {}) const;
+  /// The positions of simulate(), handed to `sink` in blocks of at most kSimulationBlock samples
+  /// instead of stored: for consumers that reduce a long capture on the fly and may stop early
+  /// (simulation_fit's give-up bound). No allocation. Returns the number of samples simulated.
+  /// The same errors as simulate().
+  std::size_t simulate_blocks(std::span<const double> command, const ModelSimulationOptions& options,
+                              PositionSink& sink) const;
   /// As simulate(), writing into `out` and reusing the capacity of its vectors: no allocation at
   /// all when they are large enough (repeated simulations, e.g. a solver scoring many models).
   void simulate_into(std::span<const double> command, ModelResponse& out,
@@ -189,6 +212,8 @@ struct FitMetrics {
   /// std_measured. No prediction driven by the command scores below it; 0 without a quantum.
   double quantization_floor = 0.0;
   std::size_t samples = 0;
+  /// false: simulation_fit gave up early (see there); nrmse is then a lower bound.
+  bool complete = true;
 };
 
 /// The count of the grid `positions` lie on: the smallest gap between distinct values, accepted
@@ -210,5 +235,16 @@ FitMetrics compare_tracking(std::span<const double> measured_error, std::span<co
 /// "actual") when the traces differ in length.
 FitMetrics simulation_fit(const AxisModel& model, std::span<const double> command, std::span<const double> actual,
                           const ModelSimulationOptions& options = {});
+
+/// simulation_fit over several records compared as one sequence (each simulated from its own
+/// first actual position unless options.initial_position is set), without storing the
+/// simulation. give_up_above: the simulation stops as soon as the nrmse reached so far exceeds it
+/// (the norm of the difference only grows, and nrmse's scale, the measured error's spread, is
+/// known before the simulation): the result then has complete = false and nrmse, rms_difference
+/// and max_difference are lower bounds, the rest undefined. The numbers of a complete result equal
+/// compare_tracking's on the same sequence. Errors as simulation_fit.
+FitMetrics simulation_fit(const AxisModel& model, std::span<const TrackingRecord> records,
+                          const ModelSimulationOptions& options,
+                          double give_up_above = std::numeric_limits<double>::infinity());
 
 }  // namespace servotwin::rapid

@@ -32,12 +32,8 @@
 
 namespace servotwin::rapid {
 
-/// One capture of one axis: commanded and measured position, equal lengths (>= 2 samples).
-struct TrackingRecord {
-  std::span<const double> command;
-  std::span<const double> actual;
-};
-
+/// Records (axis_model.hpp's TrackingRecord): one capture of one axis, commanded and measured
+/// position, equal lengths (>= 2 samples).
 struct RefineOptions {
   int max_iterations = 60;  ///< Levenberg-Marquardt iterations
   /// Stop when an accepted step lowers the cost by less than this fraction.

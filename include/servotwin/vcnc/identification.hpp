@@ -4,6 +4,7 @@
 /// one or more captures (concatenated experiments), the chosen solver, and the simulation-based
 /// fit of the identified model on the identification and validation captures.
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -52,6 +53,9 @@ struct ShiftTrial {
   int shift = 0;
   double nrmse = 0.0;  ///< simulated tracking error on the identification captures
   bool stable = false;
+  /// false: the simulation stopped once this shift could no longer be chosen (its nrmse already
+  /// above the best one's by more than the choice's tolerance); nrmse is then a lower bound.
+  bool complete = true;
 };
 
 /// Everything an identification produced (written as a servotwin.axis-model/1 file by io).
@@ -91,9 +95,11 @@ rapid::RegressionProblem axis_problem(const std::vector<NamedCapture>& captures,
                                       const rapid::RegressorOptions& options, std::vector<std::string>& warnings);
 
 /// Simulation-based tracking-error fit of a model on captures (all samples pooled); each capture
-/// is simulated from its first measured position.
+/// is simulated from its first measured position. give_up_above: as rapid::simulation_fit (the
+/// shift search stops a candidate that can no longer be chosen).
 rapid::FitMetrics simulated_fit(const rapid::AxisModel& model, const std::vector<NamedCapture>& captures,
-                                const std::string& axis, int command_shift);
+                                const std::string& axis, int command_shift,
+                                double give_up_above = std::numeric_limits<double>::infinity());
 
 /// Names of the axes (in the first capture's order) whose command moves in at least one capture:
 /// the axes an identification can say something about. A 3-axis capture of a one-axis program
