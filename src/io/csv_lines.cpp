@@ -100,23 +100,27 @@ bool is_skippable_line(std::string_view line, std::string_view prefix) noexcept 
   return i == line.size() || line.substr(i, prefix.size()) == prefix;
 }
 
-double parse_number(const Field& field, core::SourceLocation where, std::string_view column_name) {
-  where.column = field.column;
+double parse_number(const Field& field, const core::SourceLocation& where, std::string_view column_name) {
+  // The location is copied only for an error: this runs for every value of a trace.
+  const auto at = [&] {
+    core::SourceLocation located = where;
+    located.column = field.column;
+    return located;
+  };
   std::string_view text = field.text;
-  if (text.empty())
-    throw core::InputError(where, "column '" + std::string(column_name) + "': empty value, expected a number");
+  if (text.empty()) throw core::InputError(at(), "column '" + std::string(column_name) + "': empty value, expected a number");
   if (text.front() == '+') text.remove_prefix(1);
   double value = 0.0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (ec == std::errc::result_out_of_range)
-    throw core::InputError(where, "column '" + std::string(column_name) + "': number '" + printable(field.text) +
-                                      "' is out of range");
+    throw core::InputError(at(), "column '" + std::string(column_name) + "': number '" + printable(field.text) +
+                                     "' is out of range");
   if (ec != std::errc() || end != text.data() + text.size())
-    throw core::InputError(where, "column '" + std::string(column_name) + "': expected a number, found '" +
-                                      printable(field.text) + "'");
+    throw core::InputError(at(), "column '" + std::string(column_name) + "': expected a number, found '" +
+                                     printable(field.text) + "'");
   if (!std::isfinite(value))
-    throw core::InputError(where, "column '" + std::string(column_name) + "': value '" + printable(field.text) +
-                                      "' is not finite (NaN and infinity are not accepted)");
+    throw core::InputError(at(), "column '" + std::string(column_name) + "': value '" + printable(field.text) +
+                                     "' is not finite (NaN and infinity are not accepted)");
   return value;
 }
 

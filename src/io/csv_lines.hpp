@@ -53,6 +53,6 @@ bool next_data_row(std::istream& in, const std::string& source, std::string& lin
 
 /// Parses a finite decimal number occupying the whole field (optional leading '+').
 /// Throws core::InputError at `where` (column filled in from the field) otherwise.
-double parse_number(const Field& field, core::SourceLocation where, std::string_view column_name);
+double parse_number(const Field& field, const core::SourceLocation& where, std::string_view column_name);
 
 }  // namespace servotwin::io::detail

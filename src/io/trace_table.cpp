@@ -1,6 +1,7 @@
 #include "trace_table.hpp"
 
 #include <charconv>
+#include <cstring>
 #include <cmath>
 #include <fmt/format.h>
 
@@ -34,7 +35,7 @@ TraceTable::TraceTable(std::istream& in, const std::string& source, const Captur
   }
   const std::string& prefix = options.format == TraceFormat::Halscope ? std::string("#") : options.comment_prefix;
   while (read_line()) {
-    if (line_number_ == 1 && line_.size() >= 3 && line_.compare(0, 3, "\xEF\xBB\xBF") == 0) line_.erase(0, 3);
+    if (line_number_ == 1 && line_.substr(0, 3) == "\xEF\xBB\xBF") line_.remove_prefix(3);
     if (is_skippable_line(line_, prefix)) {
       if (options.format == TraceFormat::Halscope) read_halscope_period(line_, line_number_);
       continue;
@@ -55,13 +56,40 @@ TraceTable::TraceTable(std::istream& in, const std::string& source, const Captur
 }
 
 bool TraceTable::read_line() {
-  if (!std::getline(in_, line_)) return false;
-  ++line_number_;
-  line_complete_ = !in_.eof();
-  return true;
+  while (true) {
+    const char* start = buffer_.data() + begin_;
+    if (const void* end = std::memchr(start, '\n', filled_ - begin_)) {
+      const auto length = static_cast<std::size_t>(static_cast<const char*>(end) - start);
+      line_ = std::string_view(start, length);
+      begin_ += length + 1;
+      consumed_ += length + 1;
+      ++line_number_;
+      line_complete_ = true;
+      return true;
+    }
+    if (end_of_input_) {
+      if (begin_ == filled_) return false;
+      line_ = std::string_view(start, filled_ - begin_);  // the last line, without a line break
+      consumed_ += filled_ - begin_;
+      begin_ = filled_;
+      ++line_number_;
+      line_complete_ = false;
+      return true;
+    }
+    // Keep the started line, make room (a line longer than the buffer doubles it) and read on.
+    const std::size_t kept = filled_ - begin_;
+    if (kept > 0 && begin_ > 0) std::memmove(buffer_.data(), start, kept);
+    begin_ = 0;
+    filled_ = kept;
+    if (buffer_.size() < kBlock) buffer_.resize(kBlock);
+    else if (filled_ == buffer_.size()) buffer_.resize(2 * buffer_.size());
+    in_.read(buffer_.data() + filled_, static_cast<std::streamsize>(buffer_.size() - filled_));
+    filled_ += static_cast<std::size_t>(in_.gcount());
+    if (!in_) end_of_input_ = true;
+  }
 }
 
-void TraceTable::read_halscope_period(const std::string& line, std::size_t number) {
+void TraceTable::read_halscope_period(std::string_view line, std::size_t number) {
   const std::string_view text = trimmed(line);
   const std::string_view lead = kHalscopePeriod;
   if (text.substr(0, lead.size()) != lead) return;
@@ -77,7 +105,7 @@ void TraceTable::read_halscope_period(const std::string& line, std::size_t numbe
 
 bool TraceTable::next(std::vector<Field>& fields) {
   if (options_.format == TraceFormat::Halsampler) return next_halsampler(fields);
-  const std::string& prefix = options_.format == TraceFormat::Halscope ? std::string("#") : options_.comment_prefix;
+  const std::string_view prefix = options_.format == TraceFormat::Halscope ? std::string_view("#") : options_.comment_prefix;
   while (read_line()) {
     if (is_skippable_line(line_, prefix)) continue;
     split_csv_line(line_, fields, delimiter_);

@@ -8,6 +8,7 @@
 #include <istream>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "csv_lines.hpp"
@@ -32,18 +33,27 @@ class TraceTable {
   /// numbers, an `overrun` between samples.
   bool next(std::vector<Field>& fields);
   [[nodiscard]] std::size_t line_number() const noexcept { return line_number_; }
+  /// Bytes of the input consumed so far (up to the end of the line read last).
+  [[nodiscard]] std::size_t consumed_bytes() const noexcept { return consumed_; }
   [[nodiscard]] const std::string& source() const noexcept { return source_; }
 
  private:
   bool read_line();
-  void read_halscope_period(const std::string& line, std::size_t number);
+  void read_halscope_period(std::string_view line, std::size_t number);
   bool next_halsampler(std::vector<Field>& fields);
   void check_not_a_counter();
 
   std::istream& in_;
   std::string source_;
   const CaptureReadOptions& options_;
-  std::string line_;
+  // Lines are cut from a block buffer (one read of kBlock bytes instead of one getline per line:
+  // issue 26, captures of hundreds of MB); line_ points into it until the next read_line.
+  static constexpr std::size_t kBlock = std::size_t{1} << 20;
+  std::string buffer_;
+  std::size_t begin_ = 0, filled_ = 0;  ///< unread bytes are buffer_[begin_, filled_)
+  bool end_of_input_ = false;
+  std::size_t consumed_ = 0;
+  std::string_view line_;
   std::size_t line_number_ = 0;
   bool line_complete_ = true;  ///< the line read last ended with a line break
   std::vector<std::string> names_;  ///< header names (the fields point into them)

@@ -74,6 +74,55 @@ TEST(CaptureCsv, WriteThenReadIsExact) {
   EXPECT_NEAR(back.t0, c.t0, 1e-15);
 }
 
+/// A stream that hides its size (no seeking), as a pipe does.
+class UnseekableBuffer : public std::stringbuf {
+ public:
+  using std::stringbuf::stringbuf;
+
+ protected:
+  pos_type seekoff(off_type, std::ios_base::seekdir, std::ios_base::openmode) override { return pos_type(-1); }
+  pos_type seekpos(pos_type, std::ios_base::openmode) override { return pos_type(-1); }
+};
+
+TEST(CaptureCsv, LongCapturesReadAcrossBlocksFromFilesAndPipes) {
+  // The reader cuts lines from 1 MiB blocks and reserves the columns from the first rows' length
+  // (issue 26). 60 000 rows (~4 MB): lines cross block boundaries, the last line has no line
+  // break, one comment line is longer than a block, and row lengths change along the file (the
+  // estimate from the first rows is then wrong and the columns grow as before). Read from a
+  // seekable stream and from one that hides its size; both give the written numbers exactly.
+  servotwin::core::Capture c;
+  c.t0 = 0.0;
+  c.ts = 0.001;
+  servotwin::core::AxisTrace x{"x", {}, {}, {}};
+  for (int k = 0; k < 60000; ++k) {
+    x.cmd.push_back(k < 1000 ? 0.0 : std::sin(1e-3 * k) / 3.0);  // short rows first, then long ones
+    x.act.push_back(k < 1000 ? 0.0 : std::cos(1.1e-3 * k) / 7.0);
+  }
+  c.axes.push_back(x);
+  std::stringstream written;
+  servotwin::io::write_capture_csv(written, c);
+  std::string text = written.str();
+  text.pop_back();  // no line break after the last row
+  const std::size_t header_end = text.find('\n') + 1;
+  text.insert(header_end, "# " + std::string((1u << 20) + 100, 'c') + "\n");
+  std::istringstream seekable(text);
+  UnseekableBuffer buffer(text);
+  std::istream unseekable(&buffer);
+  for (std::istream* in : {static_cast<std::istream*>(&seekable), &unseekable}) {
+    const auto back = read_capture_csv(*in, "long.csv");
+    ASSERT_EQ(back.size(), 60000U);
+    EXPECT_EQ(back.axes[0].cmd, x.cmd);
+    EXPECT_EQ(back.axes[0].act, x.act);
+    EXPECT_NEAR(back.ts, 0.001, 1e-15);
+  }
+  // An error far into the file still names its line: 1 header + 1 comment + row 50001.
+  std::string bad = text;
+  std::size_t line_start = header_end;
+  for (int row = 0; row < 50001; ++row) line_start = bad.find('\n', line_start) + 1;
+  bad.insert(bad.find(',', line_start) + 1, "x");
+  EXPECT_THAT(error_of(bad), HasSubstr("cap.csv:50003:"));
+}
+
 TEST(CaptureCsv, TimeColumnPrintsWithoutNoiseDigits) {
   servotwin::core::Capture c;
   c.ts = 0.001;
