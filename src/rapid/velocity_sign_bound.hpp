@@ -14,11 +14,15 @@
 // the bounds above zero is a certificate that holds for any speed of the model (a fast mode has
 // decayed within the sample, so its envelope is small); the tangent test it complements
 // (crossing_possible) assumes a velocity close to a parabola and is only used on slow models.
+// When the per-mode bounds leave a sample open (a ringing pair beside a small velocity), the
+// whole velocity on a grid of 8 intervals, each chord lowered by its interpolation error, decides.
 // Time is scaled by the sample period (l ts, v' ts, v'' ts^2) so that the Vandermonde system is
 // of order one for the models the thesis bounds.
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <complex>
 #include <limits>
 

@@ -3,8 +3,10 @@
 // commands).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "servotwin/core/error.hpp"
@@ -181,6 +183,53 @@ TEST(ReadingQuantum, NoCountInAContinuousOrTooPoorReading) {
   EXPECT_EQ(reading_quantum(std::vector<double>{}), 0.0);
   // Non-finite samples are not positions: the rest still shows its grid.
   EXPECT_NEAR(reading_quantum(std::vector<double>{0.0, std::nan(""), 0.25, 0.75, 1.0}), 0.25, 1e-15);
+}
+
+// The rule of reading_quantum written the plain way (sort a copy, drop repeats, check the gaps):
+// the reference its one-pass grid buckets must reproduce bit for bit.
+double sorted_quantum(std::vector<double> values) {
+  std::erase_if(values, [](double v) { return !std::isfinite(v); });
+  std::sort(values.begin(), values.end());
+  values.erase(std::unique(values.begin(), values.end()), values.end());
+  if (values.size() < 3) return 0.0;
+  double count = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 1; k < values.size(); ++k) count = std::min(count, values[k] - values[k - 1]);
+  if (count <= 1e-12 * std::max(std::abs(values.front()), std::abs(values.back()))) return 0.0;
+  for (std::size_t k = 1; k < values.size(); ++k) {
+    const double steps = (values[k] - values[k - 1]) / count;
+    if (std::abs(steps - std::round(steps)) > 0.01) return 0.0;
+  }
+  return count;
+}
+
+TEST(ReadingQuantum, OnePassEqualsSortingOnCleanNoisyAndFastReadings) {
+  // Clean counts (the one-pass path), counts printed with noise in the last digits or off the grid
+  // by a fraction (sorting decides), readings that move two or more counts per sample (the
+  // smallest consecutive change is not the count), repeats, a NaN.
+  std::mt19937_64 rng(26);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 60; ++trial) {
+    const double q = std::pow(10.0, -1.0 - 4.0 * unit(rng)), offset = 20.0 * unit(rng) - 10.0;
+    const int stride = trial % 3 == 2 ? 2 + trial % 5 : 1;
+    std::vector<double> x;
+    long index = 0;
+    for (int k = 0; k < 3000; ++k) {
+      index += stride * (static_cast<long>(std::floor(3.0 * unit(rng))) - 1);
+      x.push_back(offset + q * static_cast<double>(index));
+    }
+    if (trial % 4 == 1) x[1234] += 1e-3 * q;                    // noise beyond round-off
+    if (trial % 4 == 3) x[77] = offset + q * (static_cast<double>(index) + 0.4);  // off the grid
+    if (trial % 7 == 0) x[5] = std::nan("");
+    EXPECT_EQ(reading_quantum(x), sorted_quantum(x)) << "trial " << trial;
+  }
+  // Every consecutive change is two counts or more, yet 2 and 3 counts both occur: the count is 1.
+  std::vector<double> fast;
+  for (const int n : {0, 2, 4, 6, 4, 2, 0, 3, 5, 7, 5, 3}) fast.push_back(0.3 + 0.01 * n);
+  EXPECT_EQ(reading_quantum(fast), sorted_quantum(fast));
+  EXPECT_NEAR(reading_quantum(fast), 0.01, 1e-12);
+  const std::vector<double> clean = quantized(sine_positions(5.0, 12.3), 1.25e-3, 0.0004);
+  EXPECT_EQ(reading_quantum(clean), sorted_quantum(clean));
+  EXPECT_GT(reading_quantum(clean), 0.0);
 }
 
 TEST(ReadingQuantum, FloorIsWhatAPerfectPredictionScoresAgainstTheQuantizedReading) {
