@@ -100,8 +100,6 @@ class ColumnResolver {
   std::vector<std::pair<std::string, std::string>> aliases_;  ///< our name -> a LinuxCNC joint pin's channel
 };
 
-/// Where each data row came from, stored compactly: rows are consecutive lines except after
-/// skipped (comment/blank) lines, so only the jumps are kept.
 /// Bytes left in a seekable stream (a file or a string), none for a pipe.
 std::optional<std::size_t> remaining_bytes(std::istream& in) {
   const std::istream::pos_type here = in.tellg();
@@ -134,6 +132,8 @@ std::size_t estimated_rows(const detail::TraceTable& table, std::size_t rows, st
   return rows + static_cast<std::size_t>(1.02 * static_cast<double>(input_bytes - consumed) / per_row);
 }
 
+/// Where each data row came from, stored compactly: rows are consecutive lines except after
+/// skipped (comment/blank) lines, so only the jumps are kept.
 class RowLines {
  public:
   void add(std::size_t row, std::size_t line) {

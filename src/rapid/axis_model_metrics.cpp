@@ -41,6 +41,39 @@ class Norm {
   double scale_ = 0.0, sum_ = 0.0;
 };
 
+// The running norms of a comparison of tracking errors, sample by sample in order (the same
+// order gives the same numbers, whether the errors come whole or block by block).
+struct RunningComparison {
+  Norm measured, predicted, difference;
+  double max_difference = 0.0;
+  std::size_t offset = 0;  // samples of the records before the current one (simulation_fit)
+
+  void add(double measured_error, double predicted_error) {
+    const double d = measured_error - predicted_error;
+    measured.add(measured_error);
+    predicted.add(predicted_error);
+    difference.add(d);
+    max_difference = std::max(max_difference, std::abs(d));
+  }
+
+  // The metrics of n samples whose measured error has the given deviation norm (about its mean);
+  // constant: the measured error never changes, so nrmse has no scale (FitMetrics::nrmse).
+  [[nodiscard]] FitMetrics metrics(std::size_t n, const Norm& deviation, bool constant) const {
+    FitMetrics m;
+    const double root_n = std::sqrt(static_cast<double>(n));
+    m.samples = n;
+    m.rms_measured = measured.value() / root_n;
+    m.rms_predicted = predicted.value() / root_n;
+    m.rms_difference = difference.value() / root_n;
+    m.max_difference = max_difference;
+    if (constant) m.nrmse = difference.value() == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();
+    else m.nrmse = difference.value() / deviation.value();
+    m.fit_percent = 100.0 * (1.0 - m.nrmse);
+    m.std_measured = deviation.value() / root_n;
+    return m;
+  }
+};
+
 }  // namespace
 
 FitMetrics compare_tracking(std::span<const double> measured_error, std::span<const double> predicted_error) {
@@ -61,29 +94,13 @@ FitMetrics compare_tracking(std::span<const double> measured_error, std::span<co
   const auto [min_it, max_it] = std::minmax_element(measured_error.begin(), measured_error.end());
   const bool constant = *min_it == *max_it;
 
-  Norm measured, predicted, difference, deviation;
-  FitMetrics m;
+  RunningComparison sums;
+  Norm deviation;
   for (std::size_t k = 0; k < n; ++k) {
-    const double d = measured_error[k] - predicted_error[k];
-    measured.add(measured_error[k]);
-    predicted.add(predicted_error[k]);
-    difference.add(d);
+    sums.add(measured_error[k], predicted_error[k]);
     deviation.add(measured_error[k] - mean);
-    m.max_difference = std::max(m.max_difference, std::abs(d));
   }
-  const double root_n = std::sqrt(count);
-  m.samples = n;
-  m.rms_measured = measured.value() / root_n;
-  m.rms_predicted = predicted.value() / root_n;
-  m.rms_difference = difference.value() / root_n;
-  if (constant) {
-    m.nrmse = difference.value() == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();
-  } else {
-    m.nrmse = difference.value() / deviation.value();
-  }
-  m.fit_percent = 100.0 * (1.0 - m.nrmse);
-  m.std_measured = deviation.value() / root_n;
-  return m;
+  return sums.metrics(n, deviation, constant);
 }
 
 namespace {
@@ -168,14 +185,6 @@ FitMetrics simulation_fit(const AxisModel& model, std::span<const double> comman
 
 namespace {
 
-// compare_tracking's running norms, fed block by block from the simulation (same order, so the
-// same numbers).
-struct RunningComparison {
-  Norm measured, predicted, difference;
-  double max_difference = 0.0;
-  std::size_t offset = 0;  // samples of the records before the current one
-};
-
 class ComparisonSink final : public PositionSink {
  public:
   ComparisonSink(const TrackingRecord& record, RunningComparison& sums, double give_up_norm)
@@ -190,11 +199,7 @@ class ComparisonSink final : public PositionSink {
         throw core::InputError(core::at_field("predicted_error[" + std::to_string(sums_.offset + k) + "]"),
                                "tracking error sample must be finite (an unstable model's prediction diverges)");
       }
-      const double d = measured - predicted;
-      sums_.measured.add(measured);
-      sums_.predicted.add(predicted);
-      sums_.difference.add(d);
-      sums_.max_difference = std::max(sums_.max_difference, std::abs(d));
+      sums_.add(measured, predicted);
     }
     gave_up_ = sums_.difference.value() > give_up_norm_;
     return !gave_up_;
@@ -256,18 +261,8 @@ FitMetrics simulation_fit(const AxisModel& model, std::span<const TrackingRecord
     if ((gave_up = sink.gave_up())) break;
   }
 
-  FitMetrics m;
-  const double root_n = std::sqrt(count);
-  m.samples = n;
+  FitMetrics m = sums.metrics(n, deviation, constant);
   m.complete = !gave_up;
-  m.rms_measured = sums.measured.value() / root_n;
-  m.rms_predicted = sums.predicted.value() / root_n;
-  m.rms_difference = sums.difference.value() / root_n;
-  m.max_difference = sums.max_difference;
-  if (constant) m.nrmse = sums.difference.value() == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();
-  else m.nrmse = sums.difference.value() / deviation.value();
-  m.fit_percent = 100.0 * (1.0 - m.nrmse);
-  m.std_measured = deviation.value() / root_n;
   return m;
 }
 

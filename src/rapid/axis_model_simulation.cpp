@@ -80,6 +80,12 @@ struct Series {
   }
 };
 
+// ||M|| = |a2| ts^2 + |a1| ts + |a3| ts^3: how fast the model is against its sampling (the series
+// piece is 1/||M|| long, the tangent test needs ||M|| <= 1).
+double speed_against_sampling(const ModelCoefficients& c, double ts) {
+  return std::abs(c.a2) * ts * ts + std::abs(c.a1) * ts + std::abs(c.a3) * ts * ts * ts;
+}
+
 // Everything one simulation needs, derived from the model once per call.
 class Integrator {
  public:
@@ -88,7 +94,7 @@ class Integrator {
     a21_ = c.a2 * ts * ts;
     a11_ = c.a1 * ts;
     a31_ = c.a3 * ts * ts * ts;
-    const double norm = std::max(1.0, std::abs(a21_) + std::abs(a11_) + std::abs(a31_));
+    const double norm = std::max(1.0, speed_against_sampling(c, ts));
     piece_ = 1.0 / norm;  // ||M|| * piece <= 1
     friction_max_ = std::max(std::abs(c.d0), std::abs(c.d1));
   }
@@ -349,7 +355,7 @@ class Integrator {
 constexpr double kMaxPieces = 4096.0;
 
 void require_bounded_event_search(const ModelCoefficients& c, double ts) {
-  const double speed = std::abs(c.a2) * ts * ts + std::abs(c.a1) * ts + std::abs(c.a3) * ts * ts * ts;
+  const double speed = speed_against_sampling(c, ts);
   if (!(speed <= kMaxPieces)) {
     throw core::InputError(core::at_field("a1"),
                            "the model's dynamics are " + std::to_string(static_cast<long long>(std::min(speed, 1e18))) +
