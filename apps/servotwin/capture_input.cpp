@@ -110,8 +110,11 @@ io::TraceProfile capture_profile(const CaptureInput& input) {
 
 io::CaptureReadOptions capture_read_options(const CaptureInput& input) { return capture_profile(input).reading; }
 
-std::vector<vcnc::NamedCapture> read_captures(const std::vector<std::string>& paths, const CaptureInput& input) {
-  const io::CaptureReadOptions options = capture_read_options(input);
+std::vector<vcnc::NamedCapture> read_captures(const std::vector<std::string>& paths, const CaptureInput& input,
+                                              const CaptureSelection& selection) {
+  io::CaptureReadOptions options = capture_read_options(input);
+  options.axes = selection.axes;
+  options.read_drive_output = selection.drive_output;
   std::vector<vcnc::NamedCapture> captures;
   for (const auto& path : paths) captures.push_back({path, io::read_capture_file(path, options)});
   return captures;

@@ -31,7 +31,13 @@ void add_capture_input_options(CLI::App& command, CaptureInput& input);
 io::TraceProfile capture_profile(const CaptureInput& input);
 /// Reader options from the parsed values (capture_profile's).
 io::CaptureReadOptions capture_read_options(const CaptureInput& input);
+/// What of a capture a command uses: memory holds only that.
+struct CaptureSelection {
+  std::vector<std::string> axes;  ///< empty: every axis with `_cmd` and `_act`
+  bool drive_output = true;       ///< the `<axis>_u` columns
+};
 /// Reads every file with the same options.
-std::vector<vcnc::NamedCapture> read_captures(const std::vector<std::string>& paths, const CaptureInput& input);
+std::vector<vcnc::NamedCapture> read_captures(const std::vector<std::string>& paths, const CaptureInput& input,
+                                              const CaptureSelection& selection = {});
 
 }  // namespace servotwin::cli

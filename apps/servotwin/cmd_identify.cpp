@@ -83,8 +83,10 @@ void apply_shift(const std::string& text, vcnc::IdentificationSettings& settings
 
 int run(const IdentifyArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<vcnc::NamedCapture> captures = read_captures(a.captures, a.reading);
-  const std::vector<vcnc::NamedCapture> validation = read_captures(a.validate, a.reading);
+  // Only the axes asked for, and no drive outputs: an hour of three axes fits in memory.
+  const CaptureSelection selection{a.axes, false};
+  const std::vector<vcnc::NamedCapture> captures = read_captures(a.captures, a.reading, selection);
+  const std::vector<vcnc::NamedCapture> validation = read_captures(a.validate, a.reading, selection);
   progress(global, "read {} capture(s){} in {:.1f} ms", captures.size(),
            validation.empty() ? "" : fmt::format(" and {} validation capture(s)", validation.size()), elapsed_ms(start));
   if (!a.program.path.empty()) {

@@ -1,6 +1,7 @@
 #include "servotwin/io/capture_csv.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cctype>
 #include <cmath>
 #include <fmt/format.h>
@@ -12,6 +13,7 @@
 
 #include "csv_lines.hpp"
 #include "number_format.hpp"
+#include "time_stamps.hpp"
 #include "servotwin/io/linuxcnc_config.hpp"
 #include "trace_table.hpp"
 
@@ -119,10 +121,13 @@ std::optional<std::size_t> remaining_bytes(std::istream& in) {
   return static_cast<std::size_t>(end - here);
 }
 
-/// Rows after this many are estimated from their mean length, so that the columns are reserved
-/// once instead of growing by copies (issue 26: the copies and their page faults were a third of
-/// reading a 1 M-row capture).
-constexpr std::size_t kRowsForEstimate = 64;
+/// The columns are reserved from the rows' mean length so far, so that they do not grow by
+/// copies (issue 26: the copies and their page faults were a third of reading a 1 M-row capture).
+/// The estimate is renewed at 64, 128, 256, ... 262 144 rows: a capture's first rows (a machine at
+/// rest, zeros) are shorter than the rest, and a column sized from them alone was three times too
+/// long and copied to its size at the end, a column's worth of memory above the capture's own.
+constexpr std::size_t kFirstRowsForEstimate = 64;
+constexpr std::size_t kLastRowsForEstimate = 262144;
 
 std::size_t estimated_rows(const detail::TraceTable& table, std::size_t rows, std::size_t input_bytes,
                            std::size_t first_row_end) {
@@ -159,23 +164,33 @@ struct ColumnSink {
   double scale;
 };
 
-void reserve_for_rows(const std::vector<ColumnSink>& sinks, std::size_t rows) {
-  for (const ColumnSink& sink : sinks) sink.target->reserve(rows);
+/// Sizes a column for `rows` rows while it is still short: a column reserved too long is
+/// copied down now (cheap) rather than at the end.
+void fit_capacity(std::vector<double>& column, std::size_t rows) {
+  if (column.capacity() > rows + rows / 4) {
+    std::vector<double> resized;
+    resized.reserve(rows);
+    resized.assign(column.begin(), column.end());
+    column.swap(resized);
+  } else if (column.capacity() < rows) {
+    column.reserve(rows);
+  }
 }
 
-void check_time_grid(const std::vector<double>& t, const RowLines& lines, double max_jitter, std::string_view source,
+void check_time_grid(const detail::TimeStamps& t, const RowLines& lines, double max_jitter, std::string_view source,
                      const std::string& column, double& t0, double& ts) {
   const std::size_t n = t.size();
   t0 = t.front();
   ts = (t.back() - t.front()) / static_cast<double>(n - 1);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double deviation = std::abs(t[k] - (t0 + static_cast<double>(k) * ts));
-    if (deviation > max_jitter * ts)
+  const double origin = t0, period = ts;
+  t.for_each([&](std::size_t k, double tk) {
+    const double deviation = std::abs(tk - (origin + static_cast<double>(k) * period));
+    if (deviation > max_jitter * period)
       throw core::InputError({std::string(source), lines.line_of(k), 0, column},
                              fmt::format("time {} is {:.3g} % of the sample period ({} s) off the uniform grid; at "
                                          "most {:.3g} % jitter is accepted (resample the file first)",
-                                         t[k], 100.0 * deviation / ts, ts, 100.0 * max_jitter));
-  }
+                                         tk, 100.0 * deviation / period, period, 100.0 * max_jitter));
+  });
 }
 
 void validate_options(const CaptureReadOptions& options, std::string_view source) {
@@ -227,12 +242,22 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
                                "); map them with --map x_cmd=<column> --map x_act=<column>");
   capture.axes.reserve(axes.size());
   for (const auto& axis : axes) capture.axes.push_back(core::AxisTrace{lower(axis), {}, {}, {}});
+  if (!options.axes.empty()) {
+    for (const auto& trace : capture.axes) {
+      if (columns.find(trace.name + "_cmd") != std::string::npos) continue;
+      std::string present;
+      for (const auto& a : columns.discover_axes()) present += (present.empty() ? "" : ", ") + a;
+      throw core::InputError({source, header_line, 0, trace.name + "_cmd"},
+                             "no axis '" + trace.name + "' in this capture (axes: " + (present.empty() ? "none" : present) +
+                                 "; columns: " + columns.column_list() + "); map one with --map " + trace.name +
+                                 "_cmd=<column>");
+    }
+  }
 
   std::vector<ColumnSink> sinks;
-  std::vector<double> time;
+  detail::TimeStamps time;
   const std::size_t t_index = columns.find("t");
-  if (t_index != std::string::npos) sinks.push_back({t_index, "t", &time, 1.0});
-  else if (!options.ts && !table.period())
+  if (t_index == std::string::npos && !options.ts && !table.period())
     throw core::InputError({source, header_line, 0, "t"},
                            "missing time column 't' (columns: " + columns.column_list() +
                                "); map one with --map t=<column> or give the sample period with --ts" +
@@ -241,7 +266,7 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
     sinks.push_back({columns.require(trace.name + "_cmd"), trace.name + "_cmd", &trace.cmd, options.scale});
     const std::size_t act = options.allow_missing_actual ? columns.find(trace.name + "_act") : columns.require(trace.name + "_act");
     if (act != std::string::npos) sinks.push_back({act, trace.name + "_act", &trace.act, options.scale});
-    const std::size_t u = columns.find(trace.name + "_u");
+    const std::size_t u = options.read_drive_output ? columns.find(trace.name + "_u") : std::string::npos;
     if (u != std::string::npos) sinks.push_back({u, trace.name + "_u", &trace.u, 1.0});
   }
 
@@ -252,6 +277,15 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
   while (table.next(fields)) {
     const std::size_t line_number = table.line_number();
     where.line = line_number;
+    if (t_index != std::string::npos) {
+      const double t = detail::parse_number(fields[t_index], where, "t");
+      if (!std::isfinite(t)) throw core::InputError({source, line_number, fields[t_index].column, "t"}, "time overflows");
+      if (rows > 0 && !(t > previous_t))
+        throw core::InputError({source, line_number, fields[t_index].column, "t"},
+                               fmt::format("time does not increase: {} after {}", t, previous_t));
+      previous_t = t;
+      time.push(t);
+    }
     for (const ColumnSink& sink : sinks) {
       const double value = detail::parse_number(fields[sink.index], where, sink.name) * sink.scale;
       if (!std::isfinite(value))
@@ -259,16 +293,13 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
                                fmt::format("value times the scale {} overflows", sink.scale));
       sink.target->push_back(value);
     }
-    if (!time.empty()) {
-      const double t = time.back();
-      if (rows > 0 && !(t > previous_t))
-        throw core::InputError({source, line_number, fields[t_index].column, "t"},
-                               fmt::format("time does not increase: {} after {}", t, previous_t));
-      previous_t = t;
-    }
     row_lines.add(rows, line_number);
     ++rows;
-    if (rows == kRowsForEstimate && input_bytes) reserve_for_rows(sinks, estimated_rows(table, rows, *input_bytes, first_row_end));
+    if (input_bytes && rows >= kFirstRowsForEstimate && rows <= kLastRowsForEstimate && std::has_single_bit(rows)) {
+      const std::size_t estimate = estimated_rows(table, rows, *input_bytes, first_row_end);
+      for (const ColumnSink& sink : sinks) fit_capacity(*sink.target, estimate);
+      time.reserve(estimate);
+    }
     if (rows == 1) first_row_end = table.consumed_bytes();
   }
   if (in.bad()) throw core::InputError({source, table.line_number(), 0, ""}, "read error");

@@ -3,9 +3,12 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <charconv>
 #include <cmath>
 #include <fstream>
+#include <random>
 #include <sstream>
+#include <vector>
 
 #include "servotwin/core/error.hpp"
 #include "servotwin/io/capture_csv.hpp"
@@ -121,6 +124,51 @@ TEST(CaptureCsv, LongCapturesReadAcrossBlocksFromFilesAndPipes) {
   for (int row = 0; row < 50001; ++row) line_start = bad.find('\n', line_start) + 1;
   bad.insert(bad.find(',', line_start) + 1, "x");
   EXPECT_THAT(error_of(bad), HasSubstr("cap.csv:50003:"));
+}
+
+/// A capture text with the given time stamps and x_cmd = x_act = row number.
+std::string with_times(const std::vector<double>& t) {
+  std::string text = "t,x_cmd,x_act\n";
+  char field[32];
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const auto r = std::to_chars(field, field + sizeof field, t[k]);
+    text.append(field, r.ptr);
+    text += "," + std::to_string(k) + "," + std::to_string(k) + "\n";
+  }
+  return text;
+}
+
+/// The grid the reader must find: t0 = t[0], ts = (t[n-1] - t[0]) / (n - 1), computed here from
+/// the doubles written (std::to_chars round-trips them exactly).
+void expect_grid(const servotwin::core::Capture& c, const std::vector<double>& t) {
+  EXPECT_EQ(c.t0, t.front());
+  EXPECT_EQ(c.ts, (t.back() - t.front()) / static_cast<double>(t.size() - 1));
+}
+
+TEST(CaptureCsv, TimeStampsKeepTheirGridAndFirstOffGridRowInEveryForm) {
+  // The reader keeps the time column as steps numbered in a dictionary (issue 26: two bytes a row)
+  // and falls back to doubles when a step does not give back the stamp exactly (times across
+  // zero) or when there are more than 65 536 distinct steps (random jitter). In every form the
+  // grid is the one computed from the stamps, and the first off-grid row is the one reported.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> jitter(-0.004, 0.004);  // below the default 1 %
+  const std::size_t n = 100000;
+  std::vector<std::vector<double>> cases(3, std::vector<double>(n));
+  for (std::size_t k = 0; k < n; ++k) {
+    cases[0][k] = 100.0 + 0.001 * static_cast<double>(k);                            // decimal steps
+    cases[1][k] = -50.0 + 0.001 * static_cast<double>(k);                            // through zero
+    cases[2][k] = 3.0 + 0.001 * (static_cast<double>(k) + jitter(rng));              // jittered
+  }
+  for (const auto& t : cases) {
+    expect_grid(read(with_times(t)), t);
+    // Row 70 000 off the grid by 3 %, row 80 000 by 5 %: the first is reported (line 70 002).
+    std::vector<double> off = t;
+    off[70000] += 0.00003;
+    off[80000] += 0.00005;
+    const std::string e = error_of(with_times(off));
+    EXPECT_THAT(e, HasSubstr("cap.csv:70002"));
+    EXPECT_THAT(e, HasSubstr("off the uniform grid"));
+  }
 }
 
 TEST(CaptureCsv, TimeColumnPrintsWithoutNoiseDigits) {

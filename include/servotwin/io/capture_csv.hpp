@@ -70,6 +70,9 @@ struct CaptureReadOptions {
   std::vector<std::string> axes;
   /// Axes may lack `_act` (a commanded trajectory only): AxisTrace::act is then empty.
   bool allow_missing_actual = false;
+  /// Read the drive outputs (`<axis>_u`) when the file has them. Readers that never use them
+  /// (identification) leave them out: on an hour of three axes they are a third of the memory.
+  bool read_drive_output = true;
 };
 
 /// Reads a capture from a stream in options.format, line by line: memory holds only the columns
