@@ -13,6 +13,7 @@
 
 #include "interpolation_detail.hpp"
 #include "servotwin/core/error.hpp"
+#include "servotwin/core/parallel.hpp"
 
 namespace servotwin::motion {
 
@@ -91,8 +92,9 @@ double nearest_on_circle(const Geometry& g, const Point& p, double lo, double hi
 /// Nearest point of a helix's or spiral's part [lo, hi]. The squared distance oscillates with the
 /// polar angle, so every local minimum lies within half a turn of a parameter where the curve's
 /// polar angle equals the query point's: Newton's method on d|p(s) - q|^2/ds = 0 from each of those
-/// (and the two ends as candidates) finds them all; the smallest wins.
-double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi) noexcept {
+/// (and the two ends as candidates) finds them all; the smallest wins. Returns its parameter and
+/// stores its point in `nearest` (a sine and cosine fewer for the caller).
+double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi, Point& nearest) noexcept {
   double u = 0.0, v = 0.0;
   for (std::size_t i = 0; i < kAxisCount; ++i) {
     u += (p[i] - g.base[i]) * g.e1[i];
@@ -100,12 +102,15 @@ double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi)
   }
   double phi0 = std::fmod(g.sense * (std::atan2(v, u) - g.angle0), kTwoPi);
   if (phi0 < 0.0) phi0 += kTwoPi;
-  double best_s = lo, best_d = squared_distance(g.position(lo), p);
+  nearest = g.position(lo);
+  double best_s = lo, best_d = squared_distance(nearest, p);
   const auto consider = [&](double s) {
-    const double d = squared_distance(g.position(s), p);
+    const Point q = g.position(s);
+    const double d = squared_distance(q, p);
     if (d < best_d) {
       best_d = d;
       best_s = s;
+      nearest = q;
     }
   };
   consider(hi);
@@ -120,13 +125,13 @@ double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi)
     previous_start = start;
     double s = start / g.rad_per_s;
     for (int it = 0; it < 50; ++it) {
-      const Point q = g.position(s), t = g.tangent(s), k = g.curvature(s);
+      const Geometry::Derivatives at = g.derivatives(s);
       double gt = 0.0, tt = 0.0, gk = 0.0;
       for (std::size_t i = 0; i < kAxisCount; ++i) {
-        const double d = q[i] - p[i];
-        gt += d * t[i];
-        tt += t[i] * t[i];
-        gk += d * k[i];
+        const double d = at.position[i] - p[i];
+        gt += d * at.tangent[i];
+        tt += at.tangent[i] * at.tangent[i];
+        gk += d * at.curvature[i];
       }
       const double curvature = tt + gk;
       // Where the distance is locally concave, step downhill by the tangent alone.
@@ -141,10 +146,14 @@ double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi)
   return best_s;
 }
 
-double nearest_parameter(const ContourSegment& seg, const Point& p, double lo, double hi) noexcept {
-  if (!seg.geo.is_arc) return nearest_on_line(seg.geo, p, lo, hi);
-  if (seg.plain_circle) return nearest_on_circle(seg.geo, p, lo, hi);
-  return nearest_on_curve(seg.geo, p, lo, hi);
+/// The nearest point of a segment's part [lo, hi]: its parameter, and the point in `nearest`.
+double nearest_on_segment(const ContourSegment& seg, const Point& p, double lo, double hi, Point& nearest) noexcept {
+  double s = 0.0;
+  if (!seg.geo.is_arc) s = nearest_on_line(seg.geo, p, lo, hi);
+  else if (seg.plain_circle) s = nearest_on_circle(seg.geo, p, lo, hi);
+  else return nearest_on_curve(seg.geo, p, lo, hi, nearest);
+  nearest = seg.geo.position(s);
+  return s;
 }
 
 /// Moves `q` (an open end of the path, `outward` = +1 at the end, -1 at the start) along the end
@@ -232,8 +241,9 @@ struct Follower {
       const ContourSegment& seg = segments[i];
       const double lo = std::max(0.0, progress - seg.s_begin);
       const double hi = std::clamp(reach - seg.s_begin, lo, seg.geo.length);
-      const double u = nearest_parameter(seg, c, lo, hi);
-      const double d = squared_distance(seg.geo.position(u), c);
+      Point q{};
+      const double u = nearest_on_segment(seg, c, lo, hi, q);
+      const double d = squared_distance(q, c);
       if (d + tie < best) {
         best = d;
         best_segment = i;
@@ -434,8 +444,8 @@ ContourPoint ContourPath::nearest_in(const Point& p_trace, double s_lo, double s
     const ContourSegment& seg = segments_[i];
     const double lo = std::clamp(s_lo - seg.s_begin, 0.0, seg.geo.length);
     const double hi = std::clamp(s_hi - seg.s_begin, lo, seg.geo.length);
-    const double s = nearest_parameter(seg, p, lo, hi);
-    const Point q = seg.geo.position(s);
+    Point q{};
+    const double s = nearest_on_segment(seg, p, lo, hi, q);
     const double d2 = squared_distance(q, p);
     if (d2 < best_d2) {
       best_d2 = d2;
@@ -632,9 +642,12 @@ PathKind CommandPolyline::kind(std::size_t k) const noexcept {
 namespace {
 
 /// Contour errors of the columns `actual` (checked), one query per sample.
+/// Samples below which a part of a contour-error computation is not worth a thread.
+constexpr std::size_t kSamplesPerPart = 8192;
+
 template <typename Query>
 std::vector<double> errors_by_sample(const Point& start, const std::vector<Axis>& axes,
-                                     const std::vector<std::vector<double>>& actual, Query query) {
+                                     const std::vector<std::vector<double>>& actual, std::size_t workers, Query query) {
   if (axes.size() != actual.size())
     throw core::InputError("contour_errors: " + std::to_string(axes.size()) + " axes but " +
                            std::to_string(actual.size()) + " position columns");
@@ -643,25 +656,28 @@ std::vector<double> errors_by_sample(const Point& start, const std::vector<Axis>
     if (column.size() != n) throw core::InputError("contour_errors: position columns differ in length");
   }
   std::vector<double> errors(n);
-  Point p = start;
-  for (std::size_t k = 0; k < n; ++k) {
-    for (std::size_t i = 0; i < axes.size(); ++i) p[static_cast<std::size_t>(axes[i])] = actual[i][k];
-    errors[k] = query(k, p);
-  }
+  // Every sample's error depends on that sample alone: parts of the trace go to the cores.
+  core::parallel_parts(n, workers, kSamplesPerPart, [&](std::size_t begin, std::size_t end) {
+    Point p = start;
+    for (std::size_t k = begin; k < end; ++k) {
+      for (std::size_t i = 0; i < axes.size(); ++i) p[static_cast<std::size_t>(axes[i])] = actual[i][k];
+      errors[k] = query(k, p);
+    }
+  });
   return errors;
 }
 
 }  // namespace
 
 std::vector<double> contour_errors(const ContourReference& path, const std::vector<Axis>& axes,
-                                   const std::vector<std::vector<double>>& actual) {
-  return errors_by_sample(path.start_point(), axes, actual,
+                                   const std::vector<std::vector<double>>& actual, std::size_t workers) {
+  return errors_by_sample(path.start_point(), axes, actual, workers,
                           [&](std::size_t k, const Point& p) { return path.nearest(k, p).signed_distance; });
 }
 
-std::vector<double> contour_errors(const ContourPath& path, const std::vector<Axis>& axes,
-                                   const std::vector<std::vector<double>>& actual, double ts, double window) {
-  return errors_by_sample(path.start_point(), axes, actual, [&](std::size_t k, const Point& p) {
+std::vector<double> contour_errors_in_window(const ContourPath& path, const std::vector<Axis>& axes,
+                                             const std::vector<std::vector<double>>& actual, double ts, double window) {
+  return errors_by_sample(path.start_point(), axes, actual, 1, [&](std::size_t k, const Point& p) {
     return path.nearest(p, static_cast<double>(k) * ts, window).signed_distance;
   });
 }

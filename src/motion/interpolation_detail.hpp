@@ -45,6 +45,14 @@ struct Geometry {
   [[nodiscard]] Point position(double s) const noexcept;
   [[nodiscard]] Point tangent(double s) const noexcept;    ///< dp/ds
   [[nodiscard]] Point curvature(double s) const noexcept;  ///< d2p/ds2
+  /// position, tangent and curvature at once, each equal bit for bit to its own function's, from
+  /// one sine and cosine (a Newton step on an arc needs all three).
+  struct Derivatives {
+    Point position{};
+    Point tangent{};
+    Point curvature{};
+  };
+  [[nodiscard]] Derivatives derivatives(double s) const noexcept;
 };
 
 Geometry make_line(const Point& start, const Point& end) noexcept;

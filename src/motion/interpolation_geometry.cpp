@@ -93,6 +93,26 @@ Point Geometry::curvature(double s) const noexcept {
   return k;
 }
 
+Geometry::Derivatives Geometry::derivatives(double s) const noexcept {
+  if (!is_arc) return {position(s), dir, {0.0, 0.0, 0.0}};
+  const double phi = s * rad_per_s;
+  const double a = angle0 + sense * phi;
+  const double r = r0 + dr * phi;
+  const double c = std::cos(a);
+  const double sn = std::sin(a);
+  const double rc = r * c;
+  const double rs = r * sn;
+  const double q = rad_per_s * rad_per_s;
+  Derivatives d;
+  // The expressions of position(), tangent() and curvature(), term for term.
+  for (std::size_t i = 0; i < kAxisCount; ++i) {
+    d.position[i] = base[i] + rc * e1[i] + rs * e2[i] + phi * rise[i];
+    d.tangent[i] = rad_per_s * (dr * (c * e1[i] + sn * e2[i]) + sense * r * (-sn * e1[i] + c * e2[i]) + rise[i]);
+    d.curvature[i] = q * (2.0 * dr * sense * (-sn * e1[i] + c * e2[i]) - r * (c * e1[i] + sn * e2[i]));
+  }
+  return d;
+}
+
 Geometry make_line(const Point& start, const Point& end) noexcept {
   Geometry g;
   g.start = start;

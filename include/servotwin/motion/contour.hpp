@@ -200,13 +200,16 @@ class CommandPolyline : public ContourReference {
 };
 
 /// Contour errors of sampled actual positions: `actual[i][k]` is axis `axes[i]` at sample k;
-/// axes not listed stay at the reference's start point. One signed error per sample.
+/// axes not listed stay at the reference's start point. One signed error per sample. The samples
+/// are shared among `workers` threads (0: every core; core/parallel.hpp), with the same result for
+/// any number.
 std::vector<double> contour_errors(const ContourReference& path, const std::vector<Axis>& axes,
-                                   const std::vector<std::vector<double>>& actual);
+                                   const std::vector<std::vector<double>>& actual, std::size_t workers = 0);
 
 /// Same for a ContourPath queried by time t = k ts with the given window (kept for callers of the
-/// time-based interface).
-std::vector<double> contour_errors(const ContourPath& path, const std::vector<Axis>& axes,
-                                   const std::vector<std::vector<double>>& actual, double ts, double window = 0.2);
+/// time-based interface; one thread).
+std::vector<double> contour_errors_in_window(const ContourPath& path, const std::vector<Axis>& axes,
+                                             const std::vector<std::vector<double>>& actual, double ts,
+                                             double window = 0.2);
 
 }  // namespace servotwin::motion

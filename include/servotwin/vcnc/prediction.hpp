@@ -38,6 +38,9 @@ struct AxisModelSpec {
 struct PredictionOptions {
   /// Contour error: the path near the commanded point, [t - window, t + window] [s].
   double contour_window_s = 0.2;
+  /// Threads the axes' simulations and the contour errors are shared among (0: every core; the
+  /// result is the same for any number).
+  std::size_t workers = 0;
 };
 
 /// Commanded and predicted motion of the program's axes, sampled at the models' period.
@@ -76,6 +79,7 @@ Prediction predict(const motion::Program& program, const std::string& program_na
 /// How predict_from_command reads a trace.
 struct CommandPredictionOptions {
   double contour_window_s = 0.2;  ///< see PredictionOptions
+  std::size_t workers = 0;        ///< see PredictionOptions
   /// Largest distance the trace's command may keep from the program's path [mm]; empty = from the
   /// program's path-control modes: 0.01 mm plus 1e-4 of the motion range for exact stop and exact
   /// path, the largest stated blend tolerance plus that for blending with a tolerance, and 10 % of
