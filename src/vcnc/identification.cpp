@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "servotwin/core/error.hpp"
+#include "servotwin/core/parallel.hpp"
 
 namespace servotwin::vcnc {
 
@@ -230,14 +231,17 @@ AxisIdentification identify_axis(const std::vector<NamedCapture>& captures, cons
                                                         std::to_string(range.last) +
                                                         " must be ascending and at most 64 samples wide");
     }
-    std::vector<AxisIdentification> candidates;
     std::vector<int> shifts;
-    IdentificationSettings one = settings;
-    for (int shift = range.first; shift <= range.last; ++shift) {
-      one.regressors.command_shift = shift;
-      candidates.push_back(solve_with_shift(captures, axis, one, bounds));
-      shifts.push_back(shift);
-    }
+    for (int shift = range.first; shift <= range.last; ++shift) shifts.push_back(shift);
+    // Each candidate is one pass over the captures and a solve, independent of the others.
+    std::vector<AxisIdentification> candidates(shifts.size());
+    core::parallel_parts(shifts.size(), settings.workers, 1, [&](std::size_t begin, std::size_t end) {
+      IdentificationSettings one = settings;
+      for (std::size_t i = begin; i < end; ++i) {
+        one.regressors.command_shift = shifts[i];
+        candidates[i] = solve_with_shift(captures, axis, one, bounds);
+      }
+    });
     std::vector<ShiftTrial> trials = fit_shift_candidates(candidates, captures, axis, shifts);
     result = std::move(candidates[choose_shift(trials)]);
     result.shift_trials = std::move(trials);

@@ -139,6 +139,16 @@ TEST_P(PresetIdentification, StoppedShiftCandidatesChangeNoChoice) {
   EXPECT_EQ(searched.coefficients().a1, chosen->coefficients().a1);
   EXPECT_EQ(searched.coefficients().d1, chosen->coefficients().d1);
   EXPECT_EQ(searched.fit->nrmse, chosen->fit->nrmse);
+  // The candidates are solved on every core (IdentificationSettings::workers = 0): one thread
+  // gives the same numbers.
+  vcnc::IdentificationSettings one_thread = searched_shift();
+  one_thread.workers = 1;
+  const auto sequential = vcnc::identify_axis({capture}, {}, "x", one_thread);
+  EXPECT_EQ(sequential.coefficients().a1, searched.coefficients().a1);
+  EXPECT_EQ(sequential.coefficients().b2, searched.coefficients().b2);
+  ASSERT_EQ(sequential.shift_trials.size(), searched.shift_trials.size());
+  for (std::size_t i = 0; i < searched.shift_trials.size(); ++i)
+    EXPECT_EQ(sequential.shift_trials[i].nrmse, searched.shift_trials[i].nrmse);
   ASSERT_EQ(searched.shift_trials.size(), each.size());
   for (std::size_t i = 0; i < each.size(); ++i) {
     const vcnc::ShiftTrial& t = searched.shift_trials[i];

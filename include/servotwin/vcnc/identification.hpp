@@ -46,6 +46,9 @@ struct IdentificationSettings {
   /// with the chosen shift: the model that simulates the measured motion best within the bounds.
   bool refine = false;
   rapid::RefineOptions refine_options;  ///< command_shift is set from the identification
+  /// Threads the shift search's candidates are solved on (0: every core; the result is the same
+  /// for any number).
+  std::size_t workers = 0;
 };
 
 /// One shift tried by the search.
