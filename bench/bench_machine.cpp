@@ -7,10 +7,12 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
 
+#include "servotwin/machine/closed_loop.hpp"
 #include "servotwin/machine/presets.hpp"
 #include "servotwin/machine/rigid_axis.hpp"
 #include "servotwin/machine/simulator.hpp"
@@ -61,6 +63,44 @@ BENCHMARK(BM_SimulatePPi)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SimulatePid)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SimulateSlidingMode)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SimulatePolePlacementZpetc)->Unit(benchmark::kMillisecond);
+
+// Reference in the same run: the fadal-pid preset's sampled closed loop as a plain difference
+// equation (machine::discrete_tracking_tf: linear, no friction, saturation, DAC or encoder), run
+// on the same two commands into a capture-sized output: the least one closed-loop axis-sample
+// costs, beside the virtual machine with every nonlinearity on (BM_SimulatePid).
+void BM_LinearClosedLoopReference(benchmark::State& state) {
+  const machine::MachineConfig m = machine::preset("fadal-pid");
+  const machine::DiscreteTransferFunction tf = machine::discrete_tracking_tf(m.axes.front(), m.ts);
+  // den(z) y = num(z) u, coefficients highest power first: with d = deg den, n = deg num,
+  // y[k] = (sum_i num_(n-i) u[k + i - d] - sum_(j<d) den_(d-j) y[k + j - d]) / den_d (a preview,
+  // n > d, reads later commands).
+  const int d = tf.den.degree(), n = tf.num.degree();
+  std::vector<double> num(static_cast<std::size_t>(n + 1)), den(static_cast<std::size_t>(d + 1));
+  for (int i = 0; i <= n; ++i) num[static_cast<std::size_t>(i)] = tf.num.coefficient_of_power(i);
+  for (int j = 0; j <= d; ++j) den[static_cast<std::size_t>(j)] = tf.den.coefficient_of_power(j);
+  const std::vector<std::vector<double>> commands = {identification_like_command(1), identification_like_command(2)};
+  for (auto _ : state) {
+    std::vector<std::vector<double>> out;
+    for (const auto& u : commands) {
+      const auto last = static_cast<std::ptrdiff_t>(u.size()) - 1;
+      std::vector<double> y(u.size());
+      for (std::ptrdiff_t k = 0; k <= last; ++k) {
+        double acc = 0.0;
+        for (int i = 0; i <= n; ++i) acc += num[static_cast<std::size_t>(i)] * u[static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(k + i - d, 0, last))];
+        for (int j = 0; j < d; ++j) {
+          const std::ptrdiff_t at = k + j - d;
+          acc -= den[static_cast<std::size_t>(j)] * (at >= 0 ? y[static_cast<std::size_t>(at)] : u.front());
+        }
+        y[static_cast<std::size_t>(k)] = acc / den[static_cast<std::size_t>(d)];
+      }
+      out.push_back(std::move(y));
+    }
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(commands.size() * commands[0].size()));
+  state.SetLabel("reference: linear difference equation of the same loop");
+}
+BENCHMARK(BM_LinearClosedLoopReference)->Unit(benchmark::kMillisecond);
 
 // With encoder noise as well (Box-Muller per sample).
 void BM_SimulatePidWithNoise(benchmark::State& state) {
