@@ -89,6 +89,23 @@ double nearest_on_circle(const Geometry& g, const Point& p, double lo, double hi
   return past_end < before_start ? hi : lo;
 }
 
+/// Whether |p(phi) - q|^2 is strictly convex over the part [phi_lo, phi_hi] of a helix: constant
+/// radius r, rise h along the axis (orthogonal to the plane), query at polar distance rho and
+/// angle phi0 (in the arc's angle). There |p - q|^2 = r^2 + rho^2 - 2 r rho cos(phi - phi0)
+/// + (h phi - w)^2, whose second derivative 2 r rho cos(phi - phi0) + 2 h^2 is positive wherever
+/// the part stays within a quarter turn of phi0 (a margin of 1e-6 rad for rounding).
+bool helix_part_is_convex(const Geometry& g, double phi0, double phi_lo, double phi_hi) noexcept {
+  if (g.dr != 0.0) return false;
+  double rise_in_plane = 0.0;
+  for (std::size_t i = 0; i < kAxisCount; ++i)
+    rise_in_plane += std::abs(g.rise[i] * g.e1[i]) + std::abs(g.rise[i] * g.e2[i]);
+  if (rise_in_plane != 0.0) return false;
+  double from = std::remainder(phi_lo - phi0, kTwoPi);  // in [-pi, pi]
+  const double to = from + (phi_hi - phi_lo);
+  constexpr double kQuarter = std::numbers::pi / 2.0 - 1e-6;
+  return from > -kQuarter && to < kQuarter;
+}
+
 /// Nearest point of a helix's or spiral's part [lo, hi]. The squared distance oscillates with the
 /// polar angle, so every local minimum lies within half a turn of a parameter where the curve's
 /// polar angle equals the query point's: Newton's method on d|p(s) - q|^2/ds = 0 from each of those
@@ -102,8 +119,8 @@ double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi,
   }
   double phi0 = std::fmod(g.sense * (std::atan2(v, u) - g.angle0), kTwoPi);
   if (phi0 < 0.0) phi0 += kTwoPi;
-  nearest = g.position(lo);
-  double best_s = lo, best_d = squared_distance(nearest, p);
+  const double phi_lo = lo * g.rad_per_s, phi_hi = hi * g.rad_per_s;
+  double best_s = lo, best_d = kInfinity;
   const auto consider = [&](double s) {
     const Point q = g.position(s);
     const double d = squared_distance(q, p);
@@ -113,8 +130,12 @@ double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi,
       nearest = q;
     }
   };
-  consider(hi);
-  const double phi_lo = lo * g.rad_per_s, phi_hi = hi * g.rad_per_s;
+  // The ends are candidates unless the part is convex (helix_part_is_convex): then its one
+  // minimum is Newton's, clamped to an end when it lies there (two sines fewer per query).
+  if (!helix_part_is_convex(g, phi0, phi_lo, phi_hi)) {
+    consider(lo);
+    consider(hi);
+  }
   // Starts: the parameters within half a turn of the part where the polar angle is the query's
   // (clamped into the part; a start repeated by the clamping is run once).
   double previous_start = -1.0;

@@ -145,21 +145,24 @@ Prediction predict(const motion::Program& program, const std::string& program_na
   out.contour_window_s = options.contour_window_s;
   limits.ts = out.ts;
   const motion::MotionPlan plan = motion::plan_motion(program, limits);
-  motion::Trajectory trajectory = motion::sample(plan, axes);
-  const std::size_t samples = trajectory.size();
-  out.axes = trajectory.axes;
-  out.command = std::move(trajectory.positions);
-  // The contour path is built while the models run: task 0 builds it, task 1 + i simulates axis i.
+  // The interpolation beside the contour path and the samples' path kinds (neither needs the
+  // other), then the axes' models, then the contour errors: each stage on every worker.
+  motion::Trajectory trajectory;
   std::shared_ptr<motion::ContourPath> path;
-  out.predicted.resize(out.axes.size());
-  core::parallel_parts(1 + out.axes.size(), options.workers, 1, [&](std::size_t begin, std::size_t end) {
+  core::parallel_parts(2, options.workers, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t task = begin; task < end; ++task) {
-      if (task == 0) path = std::make_shared<motion::ContourPath>(program, plan, options.contour_window_s);
-      else simulate_axis(*by_axis[static_cast<std::size_t>(out.axes[task - 1])], out, task - 1);
+      if (task == 0) {
+        trajectory = motion::sample(plan, axes);
+      } else {
+        path = std::make_shared<motion::ContourPath>(program, plan, options.contour_window_s);
+        out.kind = kinds_of(*path, plan.sample_count(), 1);
+      }
     }
   });
+  out.axes = trajectory.axes;
+  out.command = std::move(trajectory.positions);
+  simulate_models(by_axis, options.workers, out);
   out.contour_error = motion::contour_errors(*path, out.axes, out.predicted, options.workers);
-  out.kind = kinds_of(*path, samples, options.workers);
   out.path = std::move(path);
   if (!limits.exact_stop_every_block) note_path_control(program, program_name, limits, out);
   return out;
