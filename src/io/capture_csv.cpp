@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "csv_lines.hpp"
+#include "servotwin/core/large_buffer.hpp"
 #include "number_format.hpp"
 #include "time_stamps.hpp"
 #include "servotwin/io/linuxcnc_config.hpp"
@@ -169,11 +170,11 @@ struct ColumnSink {
 void fit_capacity(std::vector<double>& column, std::size_t rows) {
   if (column.capacity() > rows + rows / 4) {
     std::vector<double> resized;
-    resized.reserve(rows);
+    core::reserve_large(resized, rows);
     resized.assign(column.begin(), column.end());
     column.swap(resized);
   } else if (column.capacity() < rows) {
-    column.reserve(rows);
+    core::reserve_large(column, rows);
   }
 }
 

@@ -3,6 +3,8 @@
 #include <bit>
 #include <limits>
 
+#include "servotwin/core/large_buffer.hpp"
+
 namespace servotwin::io::detail {
 
 namespace {
@@ -50,8 +52,8 @@ void TimeStamps::push(double t) {
 }
 
 void TimeStamps::reserve(std::size_t rows) {
-  if (plain_) values_.reserve(rows);
-  else if (rows > 0) codes_.reserve(rows - 1);
+  if (plain_) core::reserve_large(values_, rows);
+  else if (rows > 0) core::reserve_large(codes_, rows - 1);
 }
 
 void TimeStamps::make_plain() {

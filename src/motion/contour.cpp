@@ -13,6 +13,7 @@
 
 #include "interpolation_detail.hpp"
 #include "servotwin/core/error.hpp"
+#include "servotwin/core/large_buffer.hpp"
 #include "servotwin/core/parallel.hpp"
 
 namespace servotwin::motion {
@@ -676,7 +677,9 @@ std::vector<double> errors_by_sample(const Point& start, const std::vector<Axis>
   for (const auto& column : actual) {
     if (column.size() != n) throw core::InputError("contour_errors: position columns differ in length");
   }
-  std::vector<double> errors(n);
+  std::vector<double> errors;
+  core::reserve_large(errors, n);
+  errors.resize(n);
   // Every sample's error depends on that sample alone: parts of the trace go to the cores.
   core::parallel_parts(n, workers, kSamplesPerPart, [&](std::size_t begin, std::size_t end) {
     Point p = start;

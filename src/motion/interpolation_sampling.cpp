@@ -9,6 +9,7 @@
 
 #include "interpolation_detail.hpp"
 #include "servotwin/core/error.hpp"
+#include "servotwin/core/large_buffer.hpp"
 
 namespace servotwin::motion {
 
@@ -165,7 +166,7 @@ void sample_into(const MotionPlan& plan, Trajectory& tr, const std::vector<Axis>
   out.count = tr.axes.size();
   for (std::size_t c = 0; c < out.count; ++c) {
     tr.positions[c].clear();
-    tr.positions[c].reserve(n);
+    core::reserve_large(tr.positions[c], n);
     out.dst[c] = &tr.positions[c];
     out.axis[c] = static_cast<std::size_t>(tr.axes[c]);
   }
@@ -205,7 +206,7 @@ double MotionPlan::speed_at(double t) const {
 
 std::vector<double> detail::sample_path_positions(const PlanData& d) {
   std::vector<double> out;
-  out.reserve(d.sample_count);
+  core::reserve_large(out, d.sample_count);
   double s = 0.0;
   out.push_back(s);
   for (const Span& span : d.spans) {

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "servotwin/core/error.hpp"
+#include "servotwin/core/large_buffer.hpp"
 #include "servotwin/core/parallel.hpp"
 #include "servotwin/vcnc/trace_check.hpp"
 
@@ -76,7 +77,7 @@ void simulate_axis(const AxisModelSpec& spec, Prediction& out, std::size_t i) {
   sim.initial_position = out.command[i].front();
   std::vector<double>& predicted = out.predicted[i];
   predicted.clear();
-  predicted.reserve(out.command[i].size());
+  core::reserve_large(predicted, out.command[i].size());
   AppendPositions sink(predicted);
   spec.model.simulate_blocks(out.command[i], sim, sink);
 }
