@@ -58,17 +58,22 @@ struct Series {
     for (int k = kTerms - 2; k >= 0; --k) r = r * s + v[static_cast<std::size_t>(k)];
     return r;
   }
-  [[nodiscard]] double acceleration(double s) const {
-    double r = static_cast<double>(kTerms - 1) * v[kTerms - 1];
-    for (int k = kTerms - 2; k >= 1; --k) r = r * s + static_cast<double>(k) * v[static_cast<std::size_t>(k)];
-    return r;
-  }
   // The velocity and its derivative in one Horner pass (the scan and Newton need both).
   void velocity_and_slope(double s, double& value, double& slope) const {
     double r = v[kTerms - 1], d = 0.0;
     for (int k = kTerms - 2; k >= 0; --k) {
       d = d * s + r;
       r = r * s + v[static_cast<std::size_t>(k)];
+    }
+    value = r;
+    slope = d;
+  }
+  // The velocity's derivative and second derivative in one Horner pass (locating its minimum).
+  void acceleration_and_jerk(double s, double& value, double& slope) const {
+    double r = static_cast<double>(kTerms - 1) * v[kTerms - 1], d = 0.0;
+    for (int k = kTerms - 2; k >= 1; --k) {
+      d = d * s + r;
+      r = r * s + static_cast<double>(k) * v[static_cast<std::size_t>(k)];
     }
     value = r;
     slope = d;
@@ -210,30 +215,55 @@ class Integrator {
     s.ei = Series::horner(series.e, sigma) * t_;
   }
 
-  // Root of h(sigma) = dir * v(sigma) + tol in [lo, hi] with h(lo) >= 0 > h(hi): safeguarded
-  // Newton (falls back to bisection whenever the Newton step leaves the bracket or stalls).
-  static double refine(const Series& series, double dir, double tol, double lo, double hi) {
+  // Root of a function h in [lo, hi] with h(lo) >= 0 > h(hi), h_and_slope(x, h, h') evaluating
+  // it: Newton kept inside the bracket, bisecting whenever its step would leave the bracket or
+  // does not at least halve the step before it (Press et al., Numerical Recipes, rtsafe). A
+  // bracket-width rule bisected after most Newton steps (one side moves at a time) and took ~50
+  // Horner passes where this takes ~5.
+  template <typename F>
+  static double safeguarded_root(F&& h_and_slope, double lo, double hi) {
     double x = 0.5 * (lo + hi);
-    double last_width = hi - lo;
+    double step_before = hi - lo, step = step_before;
+    double h = 0.0, dh = 0.0;
+    h_and_slope(x, h, dh);
     for (int it = 0; it < 100; ++it) {
-      double value = 0.0, slope = 0.0;
-      series.velocity_and_slope(x, value, slope);
-      const double h = dir * value + tol;
       (h >= 0.0 ? lo : hi) = x;
-      if (hi - lo <= 4.0 * kEps * hi) break;
-      const double dh = dir * slope;
       const double newton = dh != 0.0 ? x - h / dh : lo;
-      const double width = hi - lo;
-      if (newton > lo && newton < hi && width < 0.5 * last_width + 8.0 * kEps * hi) {
-        const bool converged = std::abs(newton - x) <= 2.0 * kEps * hi;
-        x = newton;
-        if (converged) break;
+      if (!(newton > lo && newton < hi) || std::abs(2.0 * h) > std::abs(step_before * dh)) {
+        step_before = step;
+        step = 0.5 * (hi - lo);
+        x = lo + step;
       } else {
-        x = 0.5 * (lo + hi);
+        step_before = step;
+        step = x - newton;
+        x = newton;
       }
-      last_width = width;
+      if (std::abs(step) <= 2.0 * kEps * hi || hi - lo <= 4.0 * kEps * hi) break;
+      h_and_slope(x, h, dh);
     }
     return std::clamp(x, lo, hi);
+  }
+
+  // Root of dir * v(sigma) + tol in [lo, hi], positive at lo and negative at hi.
+  static double refine(const Series& series, double dir, double tol, double lo, double hi) {
+    return safeguarded_root(
+        [&](double x, double& h, double& dh) {
+          series.velocity_and_slope(x, h, dh);
+          h = dir * h + tol;
+          dh *= dir;
+        },
+        lo, hi);
+  }
+
+  // The minimum of dir * v in [lo, hi], where its slope goes from - to +: the root of -dir * v'.
+  static double minimum(const Series& series, double dir, double lo, double hi) {
+    return safeguarded_root(
+        [&](double x, double& h, double& dh) {
+          series.acceleration_and_jerk(x, h, dh);
+          h *= -dir;
+          dh *= -dir;
+        },
+        lo, hi);
   }
 
   // First sigma in (0, length] where dir * v < -tol, or NaN when there is none. The polynomial
@@ -251,12 +281,7 @@ class Integrator {
       if (h < 0.0) return refine(series, dir, tol, s_prev, s);
       const double slope = dir * derivative;
       if (slope_prev < 0.0 && slope > 0.0) {
-        double lo = s_prev, hi = s;  // bisection on the slope for the minimum
-        for (int it = 0; it < 60 && hi - lo > 4.0 * kEps * hi; ++it) {
-          const double mid = 0.5 * (lo + hi);
-          (dir * series.acceleration(mid) < 0.0 ? lo : hi) = mid;
-        }
-        const double s_min = 0.5 * (lo + hi);
+        const double s_min = minimum(series, dir, s_prev, s);
         if (dir * series.velocity(s_min) + tol < 0.0) return refine(series, dir, tol, s_prev, s_min);
       }
       s_prev = s;
