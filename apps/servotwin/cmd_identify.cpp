@@ -107,6 +107,7 @@ int run(const IdentifyArgs& a, const GlobalOptions& global) {
   settings.regressors.trim_end = static_cast<std::size_t>(std::llround(a.trim_end_s / ts));
   if (a.deadband_opt->count() > 0) settings.regressors.velocity_deadband = a.deadband;
   settings.refine = a.refine;
+  settings.workers = global.threads;
 
   const std::vector<std::string> axes = axes_to_identify(a, captures, global);
   const io::TraceProfile profile = capture_profile(a.reading);

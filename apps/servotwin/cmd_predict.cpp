@@ -40,11 +40,12 @@ std::vector<vcnc::AxisModelSpec> load_models(const std::vector<std::string>& pat
 
 /// From the program, interpolated by servotwin; with --capture, aligned and scored.
 std::pair<vcnc::Prediction, std::optional<vcnc::MeasuredComparison>> predict_program(
-    const PredictArgs& a, const std::vector<vcnc::AxisModelSpec>& models) {
+    const PredictArgs& a, const std::vector<vcnc::AxisModelSpec>& models, std::size_t threads) {
   const ResolvedInterpolation interpolation = resolve_interpolation(a.interpolation);
   const motion::Program program = load_program(a.program, interpolation.start);
   vcnc::PredictionOptions options;
   options.contour_window_s = a.window_s;
+  options.workers = threads;
   vcnc::Prediction prediction = vcnc::predict(program, a.program.path, interpolation.limits, models, options);
   std::optional<vcnc::MeasuredComparison> comparison;
   if (!a.capture.empty()) {
@@ -56,7 +57,7 @@ std::pair<vcnc::Prediction, std::optional<vcnc::MeasuredComparison>> predict_pro
 
 /// From the trace's own command (thesis 4.3.3); its measured positions, when it has them, scored.
 std::pair<vcnc::Prediction, std::optional<vcnc::MeasuredComparison>> predict_command(
-    const PredictArgs& a, const std::vector<vcnc::AxisModelSpec>& models) {
+    const PredictArgs& a, const std::vector<vcnc::AxisModelSpec>& models, std::size_t threads) {
   io::CaptureReadOptions reading = capture_read_options(a.reading);
   reading.allow_missing_actual = true;
   const core::Capture trace = io::read_capture_file(a.command, reading);
@@ -64,6 +65,7 @@ std::pair<vcnc::Prediction, std::optional<vcnc::MeasuredComparison>> predict_com
   if (!a.program.path.empty()) program = load_program(a.program);
   vcnc::CommandPredictionOptions options;
   options.contour_window_s = a.window_s;
+  options.workers = threads;
   if (a.path_tolerance_opt->count() > 0) options.path_tolerance_mm = a.path_tolerance;
   if (!a.offset.empty()) {
     if (a.offset.size() > motion::kAxisCount)
@@ -94,7 +96,8 @@ int run(const PredictArgs& a, const GlobalOptions& global) {
                            "is for predictions from the program");
   const auto report_file = open_report(a.report, global);
   const std::vector<vcnc::AxisModelSpec> models = load_models(a.models);
-  auto [prediction, comparison] = a.command.empty() ? predict_program(a, models) : predict_command(a, models);
+  auto [prediction, comparison] =
+      a.command.empty() ? predict_program(a, models, global.threads) : predict_command(a, models, global.threads);
   progress(global, "predicted {} axis(es) over {} samples in {:.1f} ms", prediction.axes.size(), prediction.size(),
            elapsed_ms(start));
   print_prediction_summary(prediction);

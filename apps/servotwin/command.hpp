@@ -28,6 +28,7 @@ enum ExitStatus : int { kSuccess = 0, kInternalError = 1, kUsageError = 2, kBadI
 struct GlobalOptions {
   bool quiet = false;  ///< no progress messages on stderr
   bool force = false;  ///< allow replacing existing output files
+  std::size_t threads = 0;  ///< worker threads for long traces (0: every core)
 };
 
 /// The action a subcommand runs after parsing; returns the exit status.

@@ -17,6 +17,10 @@ int main(int argc, char** argv) {
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "No progress messages on stderr");
   app.add_flag("-f,--force", global.force, "Overwrite existing output files");
+  app.add_option("-j,--threads", global.threads,
+                 "Worker threads for long traces (predict, identify); 0 = every core (default). The results are "
+                 "the same for any number")
+      ->check(CLI::Range(std::size_t{0}, std::size_t{1024}));
   app.footer(
       "\nRun 'servotwin <command> --help' for the options and examples of a command.\n"
       "Exit status: 0 success, 2 usage error, 3 bad input (file, value), 1 internal error.");

@@ -283,6 +283,13 @@ TEST_F(Predict, IssueCommandFormWithAndWithoutAMeasuredCapture) {
   const std::string csv = slurp(path("prediction.csv"));
   EXPECT_THAT(csv, testing::StartsWith("t,x_cmd,x_pred,x_err,y_cmd,y_pred,y_err,contour_err,path\n"));
   EXPECT_THAT(csv, HasSubstr(",arc\n"));
+  // One worker thread (--threads 1) gives the same file as every core, and a thread count that is
+  // not a number in range is a usage error.
+  ASSERT_EQ(run("-j 1 predict --model model_x.json --model model_y.json --program circle.nc --machine fadal-pid "
+                "-o one_thread.csv").status, 0);
+  EXPECT_EQ(slurp(path("one_thread.csv")), csv);
+  EXPECT_EQ(run("--threads -2 predict --model model_x.json --program circle.nc").status, 2);
+  EXPECT_EQ(run("--threads many predict --model model_x.json --program circle.nc").status, 2);
 
   // The same program run on the virtual machine, scored against the prediction.
   ASSERT_EQ(run("capture --machine fadal-pid --program circle.nc -o measured.csv").status, 0);
