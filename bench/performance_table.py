@@ -71,8 +71,9 @@ def wall_and_peak_median(command):
         start = time.perf_counter()
         child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         _, status, usage = os.wait4(child.pid, 0)
+        child.returncode = os.waitstatus_to_exitcode(status)  # reaped here, for its rusage
         times.append(time.perf_counter() - start)
-        if status != 0:
+        if child.returncode != 0:
             raise RuntimeError(f"{command} failed")
         peaks.append(usage.ru_maxrss / 1024.0)  # kB on Linux
     return statistics.median(times), statistics.median(peaks)
@@ -135,10 +136,13 @@ def prediction_rows(servotwin, tmp):
     without = wall_median([servotwin, "-q", "predict", *models, "-p", program])
     with_csv = wall_median([servotwin, "-q", "predict", *models, "-p", program, "-o", csv], before=remove_csv)
     size = os.path.getsize(csv)
+    writing = with_csv - without
+    if writing <= 0.0:
+        raise RuntimeError(f"predict -o took {with_csv:.3f} s, not more than without -o ({without:.3f} s): rerun")
     rows.append((f"`servotwin predict ... -o` of that program: the {size / 1e6:.0f} MB CSV (time with -o less time "
-                 f"without; without: {without:.2f} s whole process)", f"{size / (with_csv - without) / 1e6:.0f} MB/s",
+                 f"without; without: {without:.2f} s whole process)", f"{size / writing / 1e6:.0f} MB/s",
                  f"std::to_chars into one buffer: {ref['bytes'] / 1e6:.0f} MB/s",
-                 f"{size / (with_csv - without) / ref['bytes']:.2f}x"))
+                 f"{size / writing / ref['bytes']:.2f}x"))
     os.remove(csv)
     return rows
 

@@ -83,8 +83,9 @@ void apply_shift(const std::string& text, vcnc::IdentificationSettings& settings
 
 int run(const IdentifyArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
-  // Only the axes asked for, and no drive outputs: an hour of three axes fits in memory.
-  const CaptureSelection selection{a.axes, false};
+  // Only the axes asked for, and no drive outputs: an hour of three axes fits in memory. A trace
+  // checked against its program (--program) keeps every axis the program may move.
+  const CaptureSelection selection{a.program.path.empty() ? a.axes : std::vector<std::string>{}, false};
   const std::vector<vcnc::NamedCapture> captures = read_captures(a.captures, a.reading, selection);
   const std::vector<vcnc::NamedCapture> validation = read_captures(a.validate, a.reading, selection);
   progress(global, "read {} capture(s){} in {:.1f} ms", captures.size(),

@@ -299,7 +299,7 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
     if (input_bytes && rows >= kFirstRowsForEstimate && rows <= kLastRowsForEstimate && std::has_single_bit(rows)) {
       const std::size_t estimate = estimated_rows(table, rows, *input_bytes, first_row_end);
       for (const ColumnSink& sink : sinks) fit_capacity(*sink.target, estimate);
-      time.reserve(estimate);
+      if (t_index != std::string::npos) time.reserve(estimate);
     }
     if (rows == 1) first_row_end = table.consumed_bytes();
   }

@@ -663,10 +663,10 @@ PathKind CommandPolyline::kind(std::size_t k) const noexcept {
 
 namespace {
 
-/// Contour errors of the columns `actual` (checked), one query per sample.
 /// Samples below which a part of a contour-error computation is not worth a thread.
 constexpr std::size_t kSamplesPerPart = 8192;
 
+/// Contour errors of the columns `actual` (checked), one query per sample.
 template <typename Query>
 std::vector<double> errors_by_sample(const Point& start, const std::vector<Axis>& axes,
                                      const std::vector<std::vector<double>>& actual, std::size_t workers, Query query) {

@@ -160,6 +160,18 @@ TEST_F(Identify, IssueCommandFormsProduceTheDocumentedFiles) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 51);
 }
 
+TEST_F(Identify, OneAxisOfATwoAxisRunIsCheckedAgainstItsProgram) {
+  // identify reads only the axes asked for (issue 26: an hour of three axes within 200 MB), but a
+  // trace checked against its program keeps every axis the program moves: the check needs the
+  // whole commanded path.
+  ASSERT_EQ(run("gcode identification --axis XY --seed 7 -o xy.nc").status, 0);
+  ASSERT_EQ(run("capture --machine fadal-pid --program xy.nc -o xy.csv").status, 0);
+  const auto r = run("identify xy.csv --axis x --program xy.nc -o x.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(read_json("x.json")["axis"], "x");
+  EXPECT_FALSE(std::filesystem::exists(path("y.json")));
+}
+
 TEST_F(Identify, StatisticsOfSeveralRunsAddUp) {
   capture("a", "fadal-pid", 7);
   capture("b", "fadal-pid", 8);

@@ -2,9 +2,11 @@
 // in part order. Expected values follow from the definition (counting).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 

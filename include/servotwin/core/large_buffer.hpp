@@ -5,8 +5,10 @@
 // is written; on a virtual machine a fault costs microseconds, and for the ten-minute prediction
 // (fifteen columns of 4.8 MB) the faults were a third of the command's time. Asking the kernel
 // for transparent huge pages on the column (madvise MADV_HUGEPAGE, where Linux offers it) makes
-// one fault fill 2 MiB instead. Only the advice differs: the memory, its contents and every
-// result are the same, and where the advice is not available nothing changes.
+// one fault fill 2 MiB instead. Only the advice differs: the contents and every result are the
+// same, and where the advice is not available nothing changes; the resident size may grow in
+// 2 MiB steps (a column's unused capacity up to its next huge page). The advice stays on the
+// address range after the column is freed, for whatever the allocator puts there next.
 
 #include <cstddef>
 #include <vector>

@@ -47,6 +47,7 @@
 /// signed error changes sign only where the distance passes zero (tested on the circle's rapid ->
 /// arc -> rapid joins and the diamond's corners, lagging and overshooting).
 ///
+#include <concepts>
 #include <cstddef>
 #include <optional>
 #include <vector>
@@ -205,6 +206,13 @@ class CommandPolyline : public ContourReference {
 /// any number.
 std::vector<double> contour_errors(const ContourReference& path, const std::vector<Axis>& axes,
                                    const std::vector<std::vector<double>>& actual, std::size_t workers = 0);
+
+/// The former time-based form, contour_errors(path, axes, actual, ts[, window]), now
+/// contour_errors_in_window: deleted so that such a call does not compile as workers = ts.
+template <std::floating_point Seconds>
+std::vector<double> contour_errors(const ContourReference& path, const std::vector<Axis>& axes,
+                                   const std::vector<std::vector<double>>& actual, Seconds ts,
+                                   double window = 0.2) = delete;
 
 /// Same for a ContourPath queried by time t = k ts with the given window (kept for callers of the
 /// time-based interface; one thread).

@@ -38,8 +38,9 @@ struct AxisModelSpec {
 struct PredictionOptions {
   /// Contour error: the path near the commanded point, [t - window, t + window] [s].
   double contour_window_s = 0.2;
-  /// Threads the axes' simulations and the contour errors are shared among (0: every core; the
-  /// result is the same for any number).
+  /// Threads the work is shared among (0: every core; the result is the same for any number): the
+  /// interpolation beside the contour path and the samples' path kinds, then the axes' models,
+  /// then the contour errors.
   std::size_t workers = 0;
 };
 
