@@ -111,8 +111,9 @@ bool helix_part_is_convex(const Geometry& g, double phi0, double phi_lo, double 
 /// polar angle, so every local minimum lies within half a turn of a parameter where the curve's
 /// polar angle equals the query point's: Newton's method on d|p(s) - q|^2/ds = 0 from each of those
 /// (and the two ends as candidates) finds them all; the smallest wins. Returns its parameter and
-/// stores its point in `nearest` (a sine and cosine fewer for the caller).
-double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi, Point& nearest) noexcept {
+/// stores its point and tangent in `nearest` and `tangent` (sines and cosines the caller spares).
+double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi, Point& nearest,
+                        Point& tangent) noexcept {
   double u = 0.0, v = 0.0;
   for (std::size_t i = 0; i < kAxisCount; ++i) {
     u += (p[i] - g.base[i]) * g.e1[i];
@@ -123,12 +124,13 @@ double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi,
   const double phi_lo = lo * g.rad_per_s, phi_hi = hi * g.rad_per_s;
   double best_s = lo, best_d = kInfinity;
   const auto consider = [&](double s) {
-    const Point q = g.position(s);
-    const double d = squared_distance(q, p);
+    const Geometry::Derivatives at = g.derivatives(s);
+    const double d = squared_distance(at.position, p);
     if (d < best_d) {
       best_d = d;
       best_s = s;
-      nearest = q;
+      nearest = at.position;
+      tangent = at.tangent;
     }
   };
   // The ends are candidates unless the part is convex (helix_part_is_convex): then its one
@@ -168,13 +170,21 @@ double nearest_on_curve(const Geometry& g, const Point& p, double lo, double hi,
   return best_s;
 }
 
-/// The nearest point of a segment's part [lo, hi]: its parameter, and the point in `nearest`.
-double nearest_on_segment(const ContourSegment& seg, const Point& p, double lo, double hi, Point& nearest) noexcept {
-  double s = 0.0;
-  if (!seg.geo.is_arc) s = nearest_on_line(seg.geo, p, lo, hi);
-  else if (seg.plain_circle) s = nearest_on_circle(seg.geo, p, lo, hi);
-  else return nearest_on_curve(seg.geo, p, lo, hi, nearest);
-  nearest = seg.geo.position(s);
+/// The nearest point of a segment's part [lo, hi]: its parameter, the point in `nearest` and the
+/// path's tangent there in `tangent` (an arc's both from one sine and cosine).
+double nearest_on_segment(const ContourSegment& seg, const Point& p, double lo, double hi, Point& nearest,
+                          Point& tangent) noexcept {
+  if (!seg.geo.is_arc) {
+    const double s = nearest_on_line(seg.geo, p, lo, hi);
+    nearest = seg.geo.position(s);
+    tangent = seg.geo.dir;
+    return s;
+  }
+  if (!seg.plain_circle) return nearest_on_curve(seg.geo, p, lo, hi, nearest, tangent);
+  const double s = nearest_on_circle(seg.geo, p, lo, hi);
+  const Geometry::Derivatives at = seg.geo.derivatives(s);
+  nearest = at.position;
+  tangent = at.tangent;
   return s;
 }
 
@@ -263,8 +273,8 @@ struct Follower {
       const ContourSegment& seg = segments[i];
       const double lo = std::max(0.0, progress - seg.s_begin);
       const double hi = std::clamp(reach - seg.s_begin, lo, seg.geo.length);
-      Point q{};
-      const double u = nearest_on_segment(seg, c, lo, hi, q);
+      Point q{}, tangent{};
+      const double u = nearest_on_segment(seg, c, lo, hi, q, tangent);
       const double d = squared_distance(q, c);
       if (d + tie < best) {
         best = d;
@@ -462,18 +472,20 @@ ContourPoint ContourPath::nearest_in(const Point& p_trace, double s_lo, double s
   const std::size_t first = segment_at(segments_, s_lo);
   ContourPoint best;
   double best_d2 = kInfinity, best_s = 0.0;
+  Point best_tangent{};
   for (std::size_t i = first; i < segments_.size() && (i == first || segments_[i].s_begin <= s_hi); ++i) {
     const ContourSegment& seg = segments_[i];
     const double lo = std::clamp(s_lo - seg.s_begin, 0.0, seg.geo.length);
     const double hi = std::clamp(s_hi - seg.s_begin, lo, seg.geo.length);
-    Point q{};
-    const double s = nearest_on_segment(seg, p, lo, hi, q);
+    Point q{}, tangent{};
+    const double s = nearest_on_segment(seg, p, lo, hi, q, tangent);
     const double d2 = squared_distance(q, p);
     if (d2 < best_d2) {
       best_d2 = d2;
       best_s = s;
       best.nearest = q;
       best.segment = i;
+      best_tangent = tangent;
     }
   }
   // Past the path's open ends the path continues along its end tangent: what lies beyond the end
@@ -481,16 +493,18 @@ ContourPoint ContourPath::nearest_in(const Point& p_trace, double s_lo, double s
   const ContourSegment& seg = segments_[best.segment];
   const bool at_start = best.segment == 0 && best_s <= 0.0;
   const bool at_end = best.segment + 1 == segments_.size() && best_s >= seg.geo.length;
-  if (at_start || at_end) extend_past_end(seg.geo.tangent(best_s), at_start ? -1.0 : 1.0, p, best.nearest);
+  if (at_start || at_end) extend_past_end(best_tangent, at_start ? -1.0 : 1.0, p, best.nearest);
   best.distance = std::sqrt(squared_distance(best.nearest, p));
-  best.signed_distance = best.distance == 0.0 ? 0.0 : best.distance * corner_side(best.segment, best_s, best.nearest, p);
+  best.signed_distance =
+      best.distance == 0.0 ? 0.0 : best.distance * corner_side(best.segment, best_s, best_tangent, best.nearest, p);
   best.nearest = plus(best.nearest, offset_);
   return best;
 }
 
-double ContourPath::corner_side(std::size_t i, double s, const Point& q, const Point& p) const noexcept {
+double ContourPath::corner_side(std::size_t i, double s, const Point& tangent, const Point& q,
+                                const Point& p) const noexcept {
   const ContourSegment& seg = segments_[i];
-  Point t = seg.geo.tangent(s);
+  Point t = tangent;
   // At a corner the side is seen from the direction halfway between the two segments' tangents,
   // so that a point past the corner (an overshoot) has the same side for both segments.
   if (s >= seg.geo.length && i + 1 < segments_.size()) t = plus(t, segments_[i + 1].geo.tangent(0.0));

@@ -161,9 +161,10 @@ class ContourPath : public ContourReference {
  private:
   ContourPath() = default;
   [[nodiscard]] ContourPoint nearest_in(const Point& p, double s_lo, double s_hi) const;
-  /// +1 / -1: the side of p seen from the nearest point q at parameter s of segment i (a corner:
-  /// from both segments' tangents).
-  [[nodiscard]] double corner_side(std::size_t i, double s, const Point& q, const Point& p) const noexcept;
+  /// +1 / -1: the side of p seen from the nearest point q at parameter s of segment i, whose
+  /// tangent there is `tangent` (a corner: from both segments' tangents).
+  [[nodiscard]] double corner_side(std::size_t i, double s, const Point& tangent, const Point& q,
+                                   const Point& p) const noexcept;
 
   std::vector<detail::ContourSegment> segments_;
   std::vector<double> progress_;  ///< path position of the command at each sample [mm]
