@@ -273,7 +273,6 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
 
   RowLines row_lines;
   std::size_t rows = 0, first_row_end = 0;
-  double previous_t = 0.0;
   core::SourceLocation where{source, 0, 0, ""};  // one string for the whole file, not one per row
   while (table.next(fields)) {
     const std::size_t line_number = table.line_number();
@@ -281,10 +280,9 @@ core::Capture read_capture_csv(std::istream& in, std::string_view source_name, c
     if (t_index != std::string::npos) {
       const double t = detail::parse_number(fields[t_index], where, "t");
       if (!std::isfinite(t)) throw core::InputError({source, line_number, fields[t_index].column, "t"}, "time overflows");
-      if (rows > 0 && !(t > previous_t))
+      if (!time.empty() && !(t > time.back()))
         throw core::InputError({source, line_number, fields[t_index].column, "t"},
-                               fmt::format("time does not increase: {} after {}", t, previous_t));
-      previous_t = t;
+                               fmt::format("time does not increase: {} after {}", t, time.back()));
       time.push(t);
     }
     for (const ColumnSink& sink : sinks) {

@@ -45,8 +45,8 @@ struct Geometry {
   [[nodiscard]] Point position(double s) const noexcept;
   [[nodiscard]] Point tangent(double s) const noexcept;    ///< dp/ds
   [[nodiscard]] Point curvature(double s) const noexcept;  ///< d2p/ds2
-  /// position, tangent and curvature at once, each equal bit for bit to its own function's, from
-  /// one sine and cosine (a Newton step on an arc needs all three).
+  /// position, tangent and curvature at once, from one sine and cosine (a Newton step on an arc
+  /// needs all three; the three functions above take their member of it on an arc).
   struct Derivatives {
     Point position{};
     Point tangent{};

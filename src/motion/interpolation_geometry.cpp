@@ -54,47 +54,24 @@ double cubic_speed_root(double k3, double p, double q) noexcept {
 
 Point Geometry::position(double s) const noexcept {
   if (!is_arc) return {start[0] + s * dir[0], start[1] + s * dir[1], start[2] + s * dir[2]};
-  const double phi = s * rad_per_s;
-  const double a = angle0 + sense * phi;
-  const double r = r0 + dr * phi;
-  const double rc = r * std::cos(a);
-  const double rs = r * std::sin(a);
-  Point p{};
-  for (std::size_t i = 0; i < kAxisCount; ++i) p[i] = base[i] + rc * e1[i] + rs * e2[i] + phi * rise[i];
-  return p;
+  return derivatives(s).position;
 }
 
 Point Geometry::tangent(double s) const noexcept {
   if (!is_arc) return dir;
-  const double phi = s * rad_per_s;
-  const double a = angle0 + sense * phi;
-  const double r = r0 + dr * phi;
-  const double c = std::cos(a);
-  const double sn = std::sin(a);
-  Point t{};
-  // dp/dphi = dr e + sense r e_perp + rise, e = c e1 + sn e2, e_perp = -sn e1 + c e2.
-  for (std::size_t i = 0; i < kAxisCount; ++i)
-    t[i] = rad_per_s * (dr * (c * e1[i] + sn * e2[i]) + sense * r * (-sn * e1[i] + c * e2[i]) + rise[i]);
-  return t;
+  return derivatives(s).tangent;
 }
 
 Point Geometry::curvature(double s) const noexcept {
   if (!is_arc) return {0.0, 0.0, 0.0};
-  const double phi = s * rad_per_s;
-  const double a = angle0 + sense * phi;
-  const double r = r0 + dr * phi;
-  const double c = std::cos(a);
-  const double sn = std::sin(a);
-  const double q = rad_per_s * rad_per_s;
-  Point k{};
-  // d2p/dphi2 = 2 dr sense e_perp - r e.
-  for (std::size_t i = 0; i < kAxisCount; ++i)
-    k[i] = q * (2.0 * dr * sense * (-sn * e1[i] + c * e2[i]) - r * (c * e1[i] + sn * e2[i]));
-  return k;
+  return derivatives(s).curvature;
 }
 
 Geometry::Derivatives Geometry::derivatives(double s) const noexcept {
   if (!is_arc) return {position(s), dir, {0.0, 0.0, 0.0}};
+  // Arc: p = base + r (cos a e1 + sin a e2) + phi rise; with e = c e1 + sn e2 and
+  // e_perp = -sn e1 + c e2, dp/dphi = dr e + sense r e_perp + rise and
+  // d2p/dphi2 = 2 dr sense e_perp - r e.
   const double phi = s * rad_per_s;
   const double a = angle0 + sense * phi;
   const double r = r0 + dr * phi;
@@ -104,7 +81,6 @@ Geometry::Derivatives Geometry::derivatives(double s) const noexcept {
   const double rs = r * sn;
   const double q = rad_per_s * rad_per_s;
   Derivatives d;
-  // The expressions of position(), tangent() and curvature(), term for term.
   for (std::size_t i = 0; i < kAxisCount; ++i) {
     d.position[i] = base[i] + rc * e1[i] + rs * e2[i] + phi * rise[i];
     d.tangent[i] = rad_per_s * (dr * (c * e1[i] + sn * e2[i]) + sense * r * (-sn * e1[i] + c * e2[i]) + rise[i]);
