@@ -35,7 +35,7 @@ struct DemoArgs {
 };
 
 void write_file(const std::filesystem::path& path, const GlobalOptions& global, const auto& writer) {
-  auto out = open_output(path.string(), global);
+  auto out = open_output(path.string(), global, "--out");
   writer(out->stream());
   out->commit();
 }

@@ -371,7 +371,7 @@ int run_measure(const MeasureArgs& a, const GlobalOptions& global) {
   const double dc_gain = closed ? 0.0 : vcnc::dc_hold_gain(plant, settings);
   // Outputs are opened before the run, so an existing file stops the command before the work.
   auto out = open_output(a.out, global);
-  auto trace_out = a.trace.empty() ? nullptr : open_output(a.trace, global);
+  auto trace_out = a.trace.empty() ? nullptr : open_output(a.trace, global, "--trace");
   progress(global, "{}: {} to {} Hz, {} listed points, start amplitude {:.4g}, limit {:.4g}, output range +-{:.4g}{}",
            config.name.empty() ? a.plant : config.name, settings.f_begin_hz, settings.f_end_hz, settings.points,
            parameters.initial_amplitude, parameters.max_amplitude, parameters.output_max,

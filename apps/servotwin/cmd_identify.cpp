@@ -125,7 +125,7 @@ int run(const IdentifyArgs& a, const GlobalOptions& global) {
     if (!a.stats_output.empty()) {
       std::vector<std::string> warnings;
       const auto problem = vcnc::axis_problem(captures, axis, record.regressors, warnings);
-      auto out = open_output(output_for(a.stats_output, axis, axes.size(), "--stats-out"), global);
+      auto out = open_output(output_for(a.stats_output, axis, axes.size(), "--stats-out"), global, "--stats-out");
       out->stream() << io::normal_equations_to_json(problem.normal_equations(), axis, a.captures,
                                                     record.regressors.command_shift)
                            .dump(2)

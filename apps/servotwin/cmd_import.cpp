@@ -57,7 +57,7 @@ int run(const ImportArgs& a, const GlobalOptions& global) {
   if (!a.save_profile.empty()) {
     profile.description = a.description;
     if (!options.ts) profile.reading.ts = capture.ts;  // the period found, for files that do not state it
-    auto out = open_output(a.save_profile, global);
+    auto out = open_output(a.save_profile, global, "--save-profile");
     io::write_trace_profile(out->stream(), profile);
     out->commit();
     progress(global, "wrote {}: read such files with --profile {}", a.save_profile, a.save_profile);

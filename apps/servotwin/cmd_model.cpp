@@ -49,7 +49,7 @@ int run(const ModelArgs& a, const GlobalOptions& global) {
   auto tracking = m.tracking().frequency_response(w);
   for (std::size_t i = 0; i < w.size(); ++i) tracking[i] *= std::polar(1.0, w[i] * loaded.command_shift * m.ts());
   const auto disturbance = m.disturbance().frequency_response(w);
-  auto out = open_output(a.frf, global);
+  auto out = open_output(a.frf, global, "--frf");
   out->stream() << "freq_hz,tracking_re,tracking_im,tracking_mag_db,tracking_phase_deg,"
                    "disturbance_re,disturbance_im,disturbance_mag_db,disturbance_phase_deg\n";
   for (std::size_t i = 0; i < f.size(); ++i)

@@ -1,9 +1,14 @@
 #include "command.hpp"
 
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
+#include <system_error>
 #include <utility>
 
 #include "servotwin/core/error.hpp"
@@ -48,9 +53,134 @@ CLI::Option* add_output_file_option(CLI::App& command, std::string& target, cons
   return option;
 }
 
-std::unique_ptr<io::OutputFile> open_output(const std::string& path, const GlobalOptions& global) {
-  return std::make_unique<io::OutputFile>(path, global.force ? io::Overwrite::Allow : io::Overwrite::Refuse);
+namespace {
+
+/// What makes two paths the same file: the device and inode of an existing file (after links),
+/// else the path made absolute with its existing part's links resolved; standard output by name.
+struct FileIdentity {
+  bool standard_output = false;
+  bool exists = false;
+  dev_t device = 0;
+  ino_t inode = 0;
+  std::string canonical;
+};
+
+FileIdentity identify(const std::string& path) {
+  FileIdentity id;
+  if (io::output_kind(path) == io::OutputKind::kStandardOutput) {
+    id.standard_output = true;
+    return id;
+  }
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0) {
+    id.exists = true;
+    id.device = info.st_dev;
+    id.inode = info.st_ino;
+  }
+  std::error_code ec;
+  id.canonical = std::filesystem::weakly_canonical(std::filesystem::absolute(path, ec), ec).string();
+  return id;
 }
+
+bool same_file(const FileIdentity& a, const FileIdentity& b) {
+  if (a.standard_output || b.standard_output) return a.standard_output && b.standard_output;
+  if (a.exists && b.exists) return a.device == b.device && a.inode == b.inode;
+  return a.exists == b.exists && !a.canonical.empty() && a.canonical == b.canonical;
+}
+
+struct Argument {
+  std::string option;  ///< the option's main name, for messages
+  std::string names;   ///< all its names, comma-separated ("-o,--output")
+  std::string value;
+};
+
+bool names_option(const Argument& argument, const std::string& option) {
+  std::size_t begin = 0;
+  while (begin <= argument.names.size()) {
+    const std::size_t end = std::min(argument.names.find(',', begin), argument.names.size());
+    if (argument.names.compare(begin, end - begin, option) == 0) return true;
+    begin = end + 1;
+  }
+  return false;
+}
+
+struct OpenedOutput {
+  std::shared_ptr<io::OutputFile> file;
+  FileIdentity identity;
+};
+
+/// The outputs and arguments of this run (the tool runs one command per process).
+struct Run {
+  std::vector<Argument> arguments;
+  std::vector<OpenedOutput> outputs;
+};
+
+Run& this_run() {
+  static Run run;
+  return run;
+}
+
+void note_arguments_of(const CLI::App& app, std::vector<Argument>& out) {
+  for (const CLI::Option* option : app.get_options()) {
+    if (option->count() == 0) continue;
+    const std::string name = option->get_name(), names = option->get_name(false, true);
+    for (const std::string& value : option->results())
+      if (!value.empty() && value != "-") out.push_back({name, names, value});
+  }
+  for (const CLI::App* sub : app.get_subcommands()) note_arguments_of(*sub, out);
+}
+
+/// Two outputs on one file, or an output onto an argument (issue 27 §2: `-o X --report X`,
+/// `interpolate -p a.nc -o a.nc --force`): the second would silently replace the first.
+void refuse_shared_file(const std::string& path, const std::string& option, const FileIdentity& id) {
+  Run& run = this_run();
+  for (const OpenedOutput& other : run.outputs)
+    if (same_file(id, other.identity))
+      throw CLI::ValidationError(option, fmt::format("'{}' is already the output of {}: two outputs cannot share one file",
+                                                     path, other.file->option()));
+  if (id.standard_output) return;
+  // The argument this output came from: its value under the option's name, else (an old spelling
+  // such as --out) the first argument with that value.
+  const auto own = [&]() -> const Argument* {
+    const Argument* first = nullptr;
+    for (const Argument& argument : run.arguments) {
+      if (argument.value != path) continue;
+      if (names_option(argument, option)) return &argument;
+      if (first == nullptr) first = &argument;
+    }
+    return first;
+  }();
+  for (const Argument& argument : run.arguments) {
+    if (&argument == own || !same_file(id, identify(argument.value))) continue;
+    throw CLI::ValidationError(
+        option, fmt::format("'{}' is also the file of {} ('{}'): an output must not replace a file the command reads "
+                            "or writes (refused even with --force); choose another name",
+                            path, argument.option, argument.value));
+  }
+}
+
+}  // namespace
+
+std::shared_ptr<io::OutputFile> open_output(const std::string& path, const GlobalOptions& global, const std::string& option) {
+  const bool device = io::output_kind(path) == io::OutputKind::kDevice;
+  const FileIdentity id = identify(path);
+  if (!device) refuse_shared_file(path, option, id);
+  auto file = std::make_shared<io::OutputFile>(path, global.force ? io::Overwrite::Allow : io::Overwrite::Refuse, option,
+                                               io::Publish::Deferred);
+  if (!device) this_run().outputs.push_back({file, id});
+  else this_run().outputs.push_back({file, {}});
+  return file;
+}
+
+void note_arguments(const CLI::App& app) { note_arguments_of(app, this_run().arguments); }
+
+void publish_outputs() {
+  Run& run = this_run();
+  for (OpenedOutput& output : run.outputs) output.file->publish();
+  run.outputs.clear();
+}
+
+void discard_outputs() { this_run().outputs.clear(); }
 
 std::vector<motion::Axis> parse_axes(const std::vector<std::string>& values, const std::string& option) {
   std::vector<motion::Axis> axes;

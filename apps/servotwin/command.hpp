@@ -22,7 +22,7 @@ namespace servotwin::cli {
 inline constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 /// Exit statuses (README "Command line").
-enum ExitStatus : int { kSuccess = 0, kInternalError = 1, kUsageError = 2, kBadInput = 3 };
+enum ExitStatus : int { kSuccess = 0, kInternalError = 1, kUsageError = 2, kBadInput = 3, kIoError = 4 };
 
 /// Options every subcommand understands.
 struct GlobalOptions {
@@ -62,8 +62,23 @@ void progress(const GlobalOptions& global, fmt::format_string<Args...> format, A
   fmt::print(stderr, "\n");
 }
 
-/// Opens an output file honouring --force; "-" writes to stdout.
-std::unique_ptr<io::OutputFile> open_output(const std::string& path, const GlobalOptions& global);
+/// Opens an output file of this run honouring --force; "-" and /dev/stdout write to stdout, devices
+/// are written in place. `option` is what the user typed for it (for messages). A regular file is
+/// written beside its target and moved into place by publish_outputs() once the command has
+/// finished, so a failing command leaves no output behind. Refused with CLI::ValidationError
+/// (exit 2), even with --force, when `path` is the same file (after resolving links) as another
+/// output of this run or as any other argument of the command, such as a file it reads.
+std::shared_ptr<io::OutputFile> open_output(const std::string& path, const GlobalOptions& global,
+                                            const std::string& option = "-o");
+
+/// Records the arguments of the parsed command chain (option and value), against which
+/// open_output checks every output. Called by main after parsing.
+void note_arguments(const CLI::App& app);
+/// Moves every committed output of this run into place (one rename each; core::IoError when one
+/// fails). Called by main after the command returned.
+void publish_outputs();
+/// Drops every output of this run that was not published (their temporary files are removed).
+void discard_outputs();
 
 /// Throws core::InputError naming `option` unless ts is a finite sample period > 0 s.
 void check_sample_period(double ts, const std::string& option = "--ts");

@@ -1,5 +1,5 @@
 // servotwin command-line tool: dispatches to one subcommand per source file and maps errors to
-// exit statuses (0 success, 2 usage error, 3 bad input, 1 internal error).
+// exit statuses (0 success, 2 usage error, 3 bad input, 4 output not written, 1 internal error).
 #include <cstdio>
 #include <exception>
 
@@ -23,7 +23,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(std::size_t{0}, std::size_t{1024}));
   app.footer(
       "\nRun 'servotwin <command> --help' for the options and examples of a command.\n"
-      "Exit status: 0 success, 2 usage error, 3 bad input (file, value), 1 internal error.");
+      "Exit status: 0 success, 2 usage error, 3 bad input (file, value), 4 an output could not be written (disk full, "
+      "closed pipe), 1 internal error.");
 
   Action selected;
   for (Registrar add : {register_gcode, register_interpolate, register_capture, register_import, register_identify, register_solve,
@@ -43,15 +44,29 @@ int main(int argc, char** argv) {
     app.exit(e);
     return kUsageError;
   }
+  note_arguments(app);
   try {
-    return selected ? selected(global) : kUsageError;
+    if (!selected) return kUsageError;
+    const int status = selected(global);
+    publish_outputs();
+    // What went to stdout outside an output file (summaries, tables) must have arrived too.
+    if (std::fflush(stdout) != 0 || std::ferror(stdout))
+      throw servotwin::core::IoError({"<stdout>", 0, 0, ""}, "writing to standard output failed");
+    return status;
   } catch (const CLI::ParseError& e) {
+    discard_outputs();
     std::fprintf(stderr, "servotwin: error: %s\n", e.what());
     return kUsageError;
+  } catch (const servotwin::core::IoError& e) {
+    discard_outputs();
+    std::fprintf(stderr, "servotwin: error: %s\n", e.what());
+    return kIoError;
   } catch (const servotwin::core::InputError& e) {
+    discard_outputs();
     std::fprintf(stderr, "servotwin: error: %s\n", e.what());
     return kBadInput;
   } catch (const std::exception& e) {
+    discard_outputs();
     std::fprintf(stderr, "servotwin: internal error: %s\n", e.what());
     return kInternalError;
   }

@@ -7,9 +7,9 @@ void add_report_option(CLI::App& command, std::string& path) {
                      "Write an interactive HTML report: one self-contained file that opens offline in a browser");
 }
 
-std::unique_ptr<io::OutputFile> open_report(const std::string& path, const GlobalOptions& global) {
+std::shared_ptr<io::OutputFile> open_report(const std::string& path, const GlobalOptions& global) {
   if (path.empty()) return nullptr;
-  return open_output(path, global);
+  return open_output(path, global, "--report");
 }
 
 void write_report(const report::Document& doc, io::OutputFile& out, const GlobalOptions& global) {

@@ -16,7 +16,7 @@ void add_report_option(CLI::App& command, std::string& path);
 /// Opens the report file before the work starts, so that an existing file (without --force) or an
 /// unwritable directory stops the command before it has written anything else. nullptr when
 /// `path` is empty (no report asked for).
-std::unique_ptr<io::OutputFile> open_report(const std::string& path, const GlobalOptions& global);
+std::shared_ptr<io::OutputFile> open_report(const std::string& path, const GlobalOptions& global);
 
 /// Writes `doc` as HTML into `out`, commits it and reports its size on stderr.
 void write_report(const report::Document& doc, io::OutputFile& out, const GlobalOptions& global);

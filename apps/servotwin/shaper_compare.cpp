@@ -92,7 +92,7 @@ int run_compare(const CompareArgs& a, const GlobalOptions& global) {
   options.freq_max_hz = a.freq_max_hz;
   if (!a.title.empty()) options.title = a.title;
   // The report file is claimed before the work, so an existing file stops the command early.
-  std::unique_ptr<io::OutputFile> report_file = open_report(a.report_path, global);
+  std::shared_ptr<io::OutputFile> report_file = open_report(a.report_path, global);
 
   std::vector<report::NamedShaper> shapers;
   shapers.reserve(a.paths.size());

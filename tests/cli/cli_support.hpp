@@ -37,14 +37,16 @@ class Cli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  Result run(const std::string& args) const {
+  /// Runs the tool with `args`; its standard output goes to `stdout_target` when given (a path
+  /// such as /dev/full), else into Result::out.
+  Result run(const std::string& args, const std::string& stdout_target = "") const {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = "cd '" + dir_.string() + "' && '" + SERVOTWIN_CLI + "' " + args + " > '" + out.string() +
-                                "' 2> '" + err.string() + "'";
+    const std::string command = "cd '" + dir_.string() + "' && '" + SERVOTWIN_CLI + "' " + args + " > '" +
+                                (stdout_target.empty() ? out.string() : stdout_target) + "' 2> '" + err.string() + "'";
     const int raw = std::system(command.c_str());
     Result r;
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = slurp(out);
+    if (stdout_target.empty()) r.out = slurp(out);
     r.err = slurp(err);
     fs::remove(out);
     fs::remove(err);

@@ -2,7 +2,7 @@
 /// \file
 /// Errors that reach the user. Every reader and algorithm reports bad user input with
 /// `InputError`, naming where the problem is (file, line, column or field) and what was expected.
-/// The command-line tool maps `InputError` to exit status 3.
+/// The command-line tool maps `InputError` to exit status 3 and `IoError` to 4.
 
 #include <cstddef>
 #include <stdexcept>
@@ -40,6 +40,14 @@ class InputError : public std::runtime_error {
  private:
   SourceLocation where_;
   std::string reason_;
+};
+
+/// A file could not be written whole: a failed write, flush, close or rename (disk full, a device
+/// such as /dev/full, a closed pipe). Derived from InputError for its location (the file and the
+/// option that named it); the command-line tool catches it first and exits with status 4.
+class IoError : public InputError {
+ public:
+  using InputError::InputError;
 };
 
 }  // namespace servotwin::core
