@@ -34,12 +34,19 @@ std::string num(double v, int digits = 4) {
 
 // ---- data -------------------------------------------------------------------------------------
 
+/// The measured points in the form the fit works on. The log-magnitudes are taken relative to
+/// their mean, log_scale, so that the fit is the same for a response in any unit (issue 27 §1: one
+/// scaled by 1e150 put the log-gain beyond kThetaLimit): θ's gain entry and the models that
+/// complete_start returns are in physical units, refine and finish convert.
 struct Data {
   std::vector<double> omega;
-  std::vector<Complex> log_meas;  ///< ln|P| + j∠P
+  std::vector<Complex> log_meas;  ///< ln|P| − log_scale + j∠P
   std::vector<double> weight;     ///< |P|/std_dev or 1
+  double log_scale = 0.0;         ///< mean of ln|P|
   bool known_std = false;
   [[nodiscard]] std::size_t size() const { return omega.size(); }
+  /// ln P of point k in physical units, to compare with a physical model.
+  [[nodiscard]] Complex measured(std::size_t k) const { return log_meas[k] + log_scale; }
 };
 
 bool has_invalid(const core::FrequencyResponse& response) {
@@ -53,7 +60,10 @@ Data make_data(const core::FrequencyResponse& response) {
     d.omega.push_back(kTwoPi * p.freq_hz);
     d.log_meas.push_back(std::log(p.value));
     d.weight.push_back(detail::log_residual_weight(p, response.quality_kind, d.known_std));
+    d.log_scale += d.log_meas.back().real();
   }
+  if (!d.log_meas.empty()) d.log_scale /= static_cast<double>(d.log_meas.size());
+  for (Complex& l : d.log_meas) l -= d.log_scale;
   return d;
 }
 
@@ -75,7 +85,7 @@ std::vector<std::size_t> outliers(const core::FrequencyResponse& response, const
   const Data d = make_data(response);
   std::vector<double> e(d.size());
   for (std::size_t i = 0; i < d.size(); ++i) {
-    const Complex diff = std::log(model.response(d.omega[i])) - d.log_meas[i];
+    const Complex diff = std::log(model.response(d.omega[i])) - d.measured(i);
     // Phases differ modulo 2π: the principal logs of two nearby values can sit on either side of ±π.
     e[i] = d.weight[i] * std::abs(Complex(diff.real(), std::remainder(diff.imag(), 2.0 * std::numbers::pi)));
   }
@@ -269,7 +279,7 @@ double cost_with_best_gain(PlantModel& m, const Data& data) {
   }
   const double sign = rotation.real() < 0.0 ? -1.0 : 1.0;
   const double log_k = swl / sw;
-  m.gain = sign * std::exp(log_k);
+  m.gain = sign * std::exp(log_k + data.log_scale);
   double cost = 0.0;
   for (std::size_t k = 0; k < data.size(); ++k) {
     const Complex e = shape[k] + Complex(log_k, sign < 0.0 ? kPi : 0.0) - data.log_meas[k];
@@ -350,9 +360,11 @@ Run refine(const PlantModel& start, const Data& data, const FitOptions& options,
   lm.covariance_scale = data.known_std ? core::LmCovarianceScale::kKnown : core::LmCovarianceScale::kEstimated;
   lm.record_history = false;
   const double sign = run.sign;
+  Eigen::VectorXd theta = to_theta(start);
+  theta[0] -= data.log_scale;
   run.lm = core::levenberg_marquardt(
       [&](const Eigen::VectorXd& t, Eigen::VectorXd& r, Eigen::MatrixXd* j) { return log_residuals(t, l, sign, data, r, j); },
-      to_theta(start), 2 * data.size(), lm);
+      theta, 2 * data.size(), lm);
   run.theta = run.lm.parameters;
   return run;
 }
@@ -388,7 +400,16 @@ detail::MisfitScale misfit_scale(const Run& run, const Layout& l, const Data& da
 
 FitResult finish(const Run& run, const Layout& l, const Data& data) {
   FitResult f;
+  f.points = data.size();
+  f.parameters = static_cast<std::size_t>(l.size());
+  f.initialization = run.start;
+  if (run.lm.status == core::LmStatus::kInvalidStart || run.theta.size() != l.size()) {
+    // No start could even be evaluated (non-finite model values there): nothing to report.
+    f.message = "no start could be evaluated: " + run.lm.message;
+    return f;
+  }
   Eigen::VectorXd t = run.theta;
+  t += data.log_scale * Eigen::VectorXd::Unit(t.size(), 0);  // the gain entry, back to physical units
   const detail::MisfitScale misfit = misfit_scale(run, l, data);
   Eigen::MatrixXd c = run.lm.covariance * misfit.factor;
   f.uncertainty_scale = misfit.factor;
@@ -397,10 +418,7 @@ FitResult finish(const Run& run, const Layout& l, const Data& data) {
   f.model = to_model(t, l, run.sign);
   f.converged = run.lm.converged();
   f.message = run.lm.message;
-  f.initialization = run.start;
   f.weighting = data.known_std ? "std_dev" : "log-relative";
-  f.points = data.size();
-  f.parameters = static_cast<std::size_t>(l.size());
   f.iterations = run.lm.iterations;
   f.cost = run.lm.cost;
   f.sigma2 = run.lm.sigma2;
@@ -409,7 +427,7 @@ FitResult finish(const Run& run, const Layout& l, const Data& data) {
   f.covariance = c;
   double sum = 0.0;
   for (std::size_t k = 0; k < data.size(); ++k) {
-    const Complex e = std::log(f.model.response(data.omega[k])) - data.log_meas[k];
+    const Complex e = std::log(f.model.response(data.omega[k])) - data.measured(k);
     sum += e.real() * e.real() + std::pow(std::remainder(e.imag(), kTwoPi), 2);
   }
   f.rms_log_error = std::sqrt(sum / static_cast<double>(data.size()));

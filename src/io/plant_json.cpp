@@ -5,6 +5,9 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "json_reader.hpp"
 #include "servotwin/core/error.hpp"
@@ -290,6 +293,27 @@ json mass_chain_to_json(const machine::MassChain& c) {
   return j;
 }
 
+
+/// The member of a `type` plant file that machine::validate's field (the chain's "stiffness[0]")
+/// came from, so that a message names what the user wrote.
+std::string json_field(const std::string& type, const std::string& field) {
+  static const std::vector<std::pair<std::string, std::string>> two_mass{
+      {"inertia[0]", "motor_inertia"}, {"inertia[1]", "load_inertia"}, {"stiffness[0]", "stiffness"},
+      {"damping[0]", "damping"},       {"viscous[0]", "motor_viscous"}, {"viscous[1]", "load_viscous"},
+      {"backlash[0]", "backlash"}};
+  if (type == "two-mass") {
+    for (const auto& [from, to] : two_mass)
+      if (field == from) return to;
+    return field;
+  }
+  static const std::vector<std::pair<std::string, std::string>> chain{
+      {"inertia", "inertias"}, {"stiffness", "stiffnesses"}, {"damping", "dampings"}};
+  if (type == "mass-chain")
+    for (const auto& [from, to] : chain)
+      if (field.rfind(from + "[", 0) == 0) return to + field.substr(from.size());
+  return field;
+}
+
 }  // namespace
 
 machine::PlantConfig parse_plant_json(std::string_view text, std::string_view source_name) {
@@ -333,7 +357,7 @@ machine::PlantConfig parse_plant_json(std::string_view text, std::string_view so
   try {
     machine::validate(plant);
   } catch (const core::InputError& e) {
-    throw core::InputError({std::string(source_name), 0, 0, e.where().field}, e.reason());
+    throw core::InputError({std::string(source_name), 0, 0, json_field(type, e.where().field)}, e.reason());
   }
   return plant;
 }

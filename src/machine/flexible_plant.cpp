@@ -23,6 +23,7 @@ constexpr int kMaxSubsteps = 4096;
 constexpr int kMinNonlinearSubsteps = 8;
 constexpr double kSubstepPhase = 0.05;  // omega_max h per sub-step
 constexpr int kMaxDelaySamples = 100000;
+constexpr double kMinSamplePeriod = 1e-7;
 
 using detail::fail;
 using detail::number;
@@ -93,6 +94,8 @@ void validate_transfer_function(const core::TransferFunction& tf) {
 
 void validate_settings(const PlantSettings& s) {
   positive(s.ts, "ts");
+  if (s.ts < kMinSamplePeriod)
+    fail("ts", "expected a sample period of at least " + number(kMinSamplePeriod) + " s (10 MHz), found " + number(s.ts));
   non_negative(s.current_lag, "current_lag");
   if (s.delay_samples < 0 || s.delay_samples > kMaxDelaySamples)
     fail("delay_samples", "expected a whole number in [0, " + std::to_string(kMaxDelaySamples) + "], found " +
@@ -102,6 +105,32 @@ void validate_settings(const PlantSettings& s) {
   if (s.substeps < 0 || s.substeps > kMaxSubsteps)
     fail("substeps", "expected 0 (automatic) or a count up to " + std::to_string(kMaxSubsteps) + ", found " +
                          std::to_string(s.substeps));
+}
+
+/// Issue 27 §1: dynamics far faster than the sample period (a stiffness of 1e300, a current lag of
+/// 1e-12 s) overflow the discretization and the transfer function's coefficients. The limit is
+/// what the sub-stepped simulation resolves, kSubstepPhase per sub-step over kMaxSubsteps: rates
+/// (a shaft's frequency sqrt(k (1/J_i + 1/J_i+1)), its damping rate b (1/J_i + 1/J_i+1), a mass's
+/// viscous rate v/J, the current loop's 1/tau) times ts up to 204.8, a mode 65 times above Nyquist.
+void validate_speed(const MassChain& c, const PlantSettings& s) {
+  constexpr double limit = kSubstepPhase * kMaxSubsteps;
+  const auto check = [&](double rate, const std::string& field, const char* what, const char* advice) {
+    if (rate * s.ts <= limit) return;
+    fail(field, std::string(what) + " is " + number(rate * s.ts) + " times the sampling rate (rad/s x ts " +
+                    number(s.ts) + " s; at most " + number(limit) + ", a mode 65 times above Nyquist, can be "
+                    "sampled or simulated): " + advice);
+  };
+  for (std::size_t i = 0; i + 1 < c.masses(); ++i) {
+    const double compliance = 1.0 / c.inertia[i] + 1.0 / c.inertia[i + 1];
+    check(std::sqrt(c.stiffness[i] * compliance), indexed("stiffness", i), "the shaft's frequency",
+          "a coupling this stiff is rigid; join the masses it couples, or use a shorter ts");
+    if (i < c.damping.size())
+      check(c.damping[i] * compliance, indexed("damping", i), "the shaft's damping rate", "check its units");
+  }
+  for (std::size_t i = 0; i < c.viscous.size(); ++i)
+    check(c.viscous[i] / c.inertia[i], indexed("viscous", i), "the viscous rate v/J", "check its units");
+  if (s.current_lag > 0.0)
+    check(1.0 / s.current_lag, "current_lag", "the current loop's rate 1/tau", "give 0 for no current loop lag");
 }
 
 // Continuous dynamics of the chain in one regime: `pinned[i]` freezes mass i (its rows are zero),
@@ -209,6 +238,7 @@ void validate(const PlantConfig& config) {
   if (const auto* chain = std::get_if<MassChain>(&config.model)) validate_chain(*chain);
   else validate_transfer_function(std::get<TransferFunctionModel>(config.model).tf);
   validate_settings(config.settings);
+  if (const auto* chain = std::get_if<MassChain>(&config.model)) validate_speed(*chain, config.settings);
   if (config.frame) {
     validate(*config.frame, "frame.");
     if (!std::holds_alternative<TransferFunctionModel>(config.model))

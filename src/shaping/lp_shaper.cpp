@@ -412,6 +412,7 @@ std::vector<LpCandidate> lp_shaper_search(const std::vector<LpMode>& modes, cons
   const double duration = max_duration(modes, base);
   std::vector<LpCandidate> candidates;
   double last_duration = 0.0;
+  int marginal = 0;  // grids the feasibility pass accepted and the solve with the cost refused
   for (int j = 1; j <= multiples; ++j) {
     const double tp = t * j;
     if (degenerate_mode(modes, tp) >= 0) continue;
@@ -421,7 +422,12 @@ std::vector<LpCandidate> lp_shaper_search(const std::vector<LpMode>& modes, cons
     if (n == 0) continue;
     bool feasible = false;
     LpCandidate candidate = solve_grid(modes, base, tp, n, &feasible);
-    if (!feasible) solver_failure("GLPK found the minimal grid infeasible when solving it with the cost", tp, n);
+    if (!feasible) {
+      // Feasible within GLPK's tolerance without the cost, infeasible with it: the constraints are
+      // nearly dependent (issue 27 §1: 40 modes 0.1 Hz apart). The grid is numerically marginal.
+      ++marginal;
+      continue;
+    }
     candidate.multiple = j;
     last_duration = candidate.grid_duration();
     candidates.push_back(std::move(candidate));
@@ -430,7 +436,13 @@ std::vector<LpCandidate> lp_shaper_search(const std::vector<LpMode>& modes, cons
     throw core::InputError(core::at_field("sample_period"),
                            "no spacing Tp = j*" + show(t) + " s (j = 1.." + std::to_string(multiples) +
                                ") admits a shaper of duration <= " + show(duration) + " s satisfying the constraints (" +
-                               describe(modes, base) + ")");
+                               describe(modes, base) + ")" +
+                               (marginal > 0 ? "; on " + std::to_string(marginal) +
+                                                   " spacing(s) the constraints were numerically dependent, as with "
+                                                   "many closely spaced modes: cancel fewer modes (one mode with a "
+                                                   "sensitivity bound covers a band), a lower derivative order, or "
+                                                   "the convolution of single-mode shapers"
+                                             : std::string()));
   // Durations (n − 1)·j·T compare exactly as integers.
   std::sort(candidates.begin(), candidates.end(), [](const LpCandidate& a, const LpCandidate& b) {
     const auto key = [](const LpCandidate& c) {

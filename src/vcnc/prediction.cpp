@@ -79,7 +79,13 @@ void simulate_axis(const AxisModelSpec& spec, Prediction& out, std::size_t i) {
   predicted.clear();
   core::reserve_large(predicted, out.command[i].size());
   AppendPositions sink(predicted);
-  spec.model.simulate_blocks(out.command[i], sim, sink);
+  try {
+    spec.model.simulate_blocks(out.command[i], sim, sink);
+  } catch (const core::InputError& e) {
+    // A model the simulation refuses (a coefficient far beyond its sample rate): name its file.
+    if (!e.where().file.empty() || spec.source.empty()) throw;
+    throw error_at(spec.source, e.where().field, e.reason());
+  }
 }
 
 /// Every axis model driven by its commanded column (with its command shift), from rest at the

@@ -400,6 +400,21 @@ TEST_F(Predict, TracesThatDoNotFitTheModelsOrTheProgramAreRefused) {
   EXPECT_FALSE(std::filesystem::exists(path("p.csv")));
 }
 
+// Issue 27 §1.2: an axis model whose coefficients are a real model's ×1e6 (a pole at tens of MHz
+// at Ts = 1 ms) hung predict; it is refused in bounded time, naming its file and a1 (the limit is
+// rapid::AxisModel's event search, tests/rapid/test_axis_model_simulation.cpp).
+TEST_F(Predict, AModelFarBeyondItsSampleRateIsRefusedNamingItsFile) {
+  models_and_toolpath("XY", "circle");
+  json m = read_json("model_x.json");
+  for (auto& [name, value] : m["model"].items()) value = value.get<double>() * 1e6;
+  write("fast_x.json", m.dump());
+  const auto r = run("predict --model fast_x.json --model model_y.json --program circle.nc --machine fadal-pid -o p.csv");
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("fast_x.json (a1)"));
+  EXPECT_THAT(r.err, HasSubstr("times faster than its sample period"));
+  EXPECT_FALSE(std::filesystem::exists(path("p.csv")));
+}
+
 TEST_F(Identify, GeneratorsStateThePathControlModeTheDialectAllows) {
   auto r = run("gcode contour --shape diamond --dialect linuxcnc --path-mode blend:0.05 -o d.ngc");
   ASSERT_EQ(r.status, 0) << r.err;

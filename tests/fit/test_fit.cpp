@@ -259,6 +259,21 @@ TEST(Fit, ResultsDoNotDependOnTheUnitsOfTheData) {
   EXPECT_NEAR(b.gain.value / a.gain.value, 1000.0, 1e-6);
   EXPECT_NEAR(b.mode_estimates[0].resonance_zeta.value, a.mode_estimates[0].resonance_zeta.value, 1e-9);
   EXPECT_NEAR(b.mode_estimates[0].antiresonance_omega.std, a.mode_estimates[0].antiresonance_omega.std, 1e-9);
+  // Issue 27 §1: ×1e150 and ×1e-150 put the log-gain beyond the parameter limit and crashed in
+  // finish; the fit works on magnitudes relative to their mean. Tolerance: the LM's convergence
+  // (relative cost reduction 1e-10), reached along different rounding.
+  for (double scale : {1e150, 1e-150}) {
+    core::FrequencyResponse scaled = metres;
+    for (auto& p : scaled.points) p.value *= scale;
+    const FitResult c = fit_plant(scaled, {}, velocity()).result;
+    ASSERT_TRUE(c.converged) << scale << ": " << c.message;
+    EXPECT_NEAR(c.gain.value / a.gain.value / scale, 1.0, 1e-6) << scale;
+    EXPECT_NEAR(c.gain.std / a.gain.std / scale, 1.0, 1e-4) << scale;
+    EXPECT_NEAR(c.mode_estimates[0].resonance_zeta.value / a.mode_estimates[0].resonance_zeta.value, 1.0, 1e-6) << scale;
+    EXPECT_NEAR(c.mode_estimates[0].antiresonance_omega.value / a.mode_estimates[0].antiresonance_omega.value, 1.0, 1e-6)
+        << scale;
+    EXPECT_NEAR(c.rms_log_error, a.rms_log_error, 1e-9) << scale;
+  }
 }
 
 TEST(FitInput, TooFewPointsNaNAndNonIncreasingFrequencies) {
