@@ -55,8 +55,9 @@ void check_option_use(const DesignArgs& a, shaping::ShaperType type) {
 }
 
 void check_mode(const DesignArgs& a) {
-  if (!std::isfinite(a.freq_hz) || a.freq_hz <= 0.0)
-    throw core::InputError(core::at_field("--freq-hz"), fmt::format("expected a frequency > 0 Hz, got {}", a.freq_hz));
+  if (!std::isfinite(a.freq_hz) || a.freq_hz < 1e-3 || a.freq_hz > 1e5)
+    throw core::InputError(core::at_field("--freq-hz"),
+                           fmt::format("expected a mode frequency from 0.001 to 1e5 Hz, got {}", a.freq_hz));
   if (!std::isfinite(a.zeta) || a.zeta < 0.0 || a.zeta >= 1.0)
     throw core::InputError(core::at_field("--zeta"), fmt::format("expected a damping ratio in [0, 1), got {}", a.zeta));
   if (a.ts_option->count() > 0) {

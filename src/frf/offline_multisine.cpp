@@ -8,6 +8,7 @@
 #include "offline_fft.hpp"
 #include "offline_support.hpp"
 #include "servotwin/core/error.hpp"
+#include "servotwin/frf/excitation_recording.hpp"
 #include "servotwin/frf/offline.hpp"
 
 namespace servotwin::frf {
@@ -73,6 +74,46 @@ Layout resolve_layout(std::size_t n, const MultisineOptions& o) {
   l.used = l.total_periods - l.skipped;
   l.dropped = n - l.total_periods * l.period;
   return l;
+}
+
+/// Below this correlation of consecutive periods the input does not repeat with the period the
+/// layout assumes (detect_period's own threshold for a periodic recording).
+constexpr double kMinPeriodCorrelation = 0.8;
+
+/// Correlation coefficient of the used input with itself one period later: close to 1 when the
+/// period is right (or a multiple of the true one), near 0 when not.
+double period_correlation(std::span<const double> v, std::size_t period) {
+  const std::size_t m = v.size() - period;
+  double mean = 0.0;
+  for (double x : v) mean += x;
+  mean /= static_cast<double>(v.size());
+  double sab = 0.0, saa = 0.0, sbb = 0.0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const double a = v[i] - mean, b = v[i + period] - mean;
+    sab += a * b;
+    saa += a * a;
+    sbb += b * b;
+  }
+  return saa > 0.0 && sbb > 0.0 ? sab / std::sqrt(saa * sbb) : 1.0;
+}
+
+/// Issue 27 §3: `--periods 7` on a record of 8 periods cut it into pieces that do not repeat, and
+/// the estimator returned a handful of meaningless lines without a word. Refuse, saying where the
+/// input does repeat.
+void require_periodic_input(std::span<const double> x, const Layout& l, const MultisineOptions& o) {
+  const auto used = x.subspan(l.skipped * l.period, l.used * l.period);
+  const double c = period_correlation(used, l.period);
+  if (c >= kMinPeriodCorrelation) return;
+  const PeriodDetection found = detect_period(x);
+  std::string hint;
+  if (found.period_samples != 0) {
+    hint = "; it repeats every " + str(found.period_samples) + " samples (correlation " + str(found.correlation, 3) + ")";
+    if (x.size() % found.period_samples == 0) hint += ", " + str(x.size() / found.period_samples) + " periods in the record";
+  }
+  throw core::InputError(core::at_field(o.period_samples != 0 ? "period" : "periods"),
+                         "the input does not repeat every " + str(l.period) + " samples (" + str(l.total_periods) +
+                             " periods): consecutive periods correlate " + str(c, 3) + ", below " +
+                             str(kMinPeriodCorrelation, 1) + hint);
 }
 
 /// Slope per sample of the drift line through the period means (see MultisineOptions::detrend).
@@ -173,6 +214,7 @@ MultisineEstimate estimate_multisine(std::span<const double> x, std::span<const 
                                      const MultisineOptions& options) {
   detail::check_signals(x, y, ts);
   const Layout layout = resolve_layout(x.size(), options);
+  require_periodic_input(x, layout, options);
   const std::size_t n_period = layout.period;
   const auto used_x = x.subspan(layout.skipped * n_period, layout.used * n_period);
   const auto used_y = y.subspan(layout.skipped * n_period, layout.used * n_period);

@@ -20,6 +20,12 @@ void append_optional(fmt::memory_buffer& buffer, double v) {
 void write_prediction_csv(std::ostream& out, const vcnc::Prediction& p, const vcnc::MeasuredComparison* measured) {
   fmt::memory_buffer buffer;
   auto sink = std::back_inserter(buffer);
+  if (!p.unstable.empty()) {
+    // A comment line before the header, only then: a diverging prediction is marked in the file.
+    buffer.append(std::string_view("# unstable_models:"));
+    for (motion::Axis axis : p.unstable) fmt::format_to(sink, " {}", motion::axis_name(axis));
+    buffer.push_back('\n');
+  }
   buffer.append(std::string_view("t"));
   for (motion::Axis axis : p.axes) {
     const char* a = motion::axis_name(axis);

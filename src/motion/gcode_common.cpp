@@ -132,6 +132,19 @@ ScannedNumber scan_number(Cursor& cursor) noexcept {
     while (pos < s.size() && is_digit(s[pos])) ++pos;
     n.fraction = s.substr(frac_begin, pos - frac_begin);
   }
+  // An exponent ("1e30") is not part of an RS274NGC or Heidenhain number; read as the number 1
+  // followed by a word E30 it would silently turn F1e30 into F1 (issue 27 §3).
+  const auto digit_at = [&](std::size_t i) { return i < s.size() && is_digit(s[i]); };
+  const bool exponent = pos < s.size() && (s[pos] == 'e' || s[pos] == 'E') &&
+                        (digit_at(pos + 1) || ((pos + 1 < s.size() && (s[pos + 1] == '+' || s[pos + 1] == '-')) && digit_at(pos + 2)));
+  if (exponent && !(n.digits.empty() && n.fraction.empty())) {
+    pos += 2;
+    while (pos < s.size() && is_digit(s[pos])) ++pos;
+    n.status = NumberStatus::Malformed;
+    n.exponent = true;
+    cursor.pos = pos;
+    return n;
+  }
   const bool continues = pos < s.size() && (s[pos] == '.' || s[pos] == '+' || s[pos] == '-');
   if (n.digits.empty() && n.fraction.empty()) {
     n.status = pos == begin ? NumberStatus::Missing : NumberStatus::Malformed;
@@ -175,7 +188,14 @@ ScannedNumber scan_number(Cursor& cursor) noexcept {
 std::string word_text(std::string_view line, std::size_t start) {
   std::size_t pos = std::min(start, line.size());
   while (pos < line.size() && is_alpha(line[pos])) ++pos;
-  while (pos < line.size() && !is_blank(line[pos]) && !is_alpha(line[pos]) && line[pos] != ';' && line[pos] != '(') ++pos;
+  const auto in_number = [&](std::size_t i) {
+    if (!is_alpha(line[i])) return true;
+    // An exponent after digits ("F1e30") belongs to the (malformed) number it follows.
+    const bool e = (line[i] == 'e' || line[i] == 'E') && i > start && is_digit(line[i - 1]);
+    const std::size_t d = i + 1 < line.size() && (line[i + 1] == '+' || line[i + 1] == '-') ? i + 2 : i + 1;
+    return e && d < line.size() && is_digit(line[d]);
+  };
+  while (pos < line.size() && !is_blank(line[pos]) && in_number(pos) && line[pos] != ';' && line[pos] != '(') ++pos;
   if (pos == start && pos < line.size()) ++pos;
   return printable(line.substr(start, pos - start));
 }
@@ -188,6 +208,9 @@ std::string number_problem(const ScannedNumber& number, std::string_view what, s
     case NumberStatus::Malformed:
     case NumberStatus::Ok: break;
   }
+  if (number.exponent)
+    return "malformed number in '" + std::string(word) +
+           "': G-code numbers have no exponent (write the plain decimal, e.g. 0.001 for 1e-3)";
   return "malformed number in '" + std::string(word) + "' (expected a plain decimal such as 12, -0.5 or +3.25)";
 }
 

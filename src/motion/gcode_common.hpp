@@ -118,6 +118,7 @@ struct ScannedNumber {
   double value = 0.0;
   bool negative = false;
   bool has_point = false;
+  bool exponent = false;      ///< Malformed because an exponent (e30, E-3) follows the digits
   std::string_view digits;    ///< integer-part digits
   std::string_view fraction;  ///< digits after the point
 };

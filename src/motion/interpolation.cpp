@@ -20,8 +20,14 @@ void require_positive(const char* field, double value) {
   if (!std::isfinite(value) || value <= 0.0) bad_limit(field, "a finite value > 0", value);
 }
 
+/// Issue 27 §3: --ts 10 sampled a 1.3 s circle four times, a trajectory no controller runs. CNC
+/// interpolation periods lie between tens of microseconds and tens of milliseconds.
+constexpr double kMaxInterpolationPeriod = 0.1;
+
 void validate(const InterpolationLimits& l) {
   require_positive("ts", l.ts);
+  if (l.ts > kMaxInterpolationPeriod)
+    bad_limit("ts", "at most 0.1 s (a CNC's interpolation period: controllers use 0.1 to 10 ms)", l.ts);
   require_positive("accel", l.accel);
   if (l.jerk) require_positive("jerk", *l.jerk);
   require_positive("rapid_feed_mm_min", l.rapid_feed_mm_min);

@@ -55,6 +55,7 @@ Section summary_section(const std::string& name, const vcnc::Prediction& p, cons
   s.text = fmt::format("{} samples at ts = {} s ({:.3f} s). Tracking error = command - position; contour error = distance "
                        "from the point to the commanded path, positive to the left of the direction of travel. Errors in um.",
                        p.size(), p.ts, static_cast<double>(p.size() > 0 ? p.size() - 1 : 0) * p.ts);
+  for (const std::string& w : p.warnings) s.text += "\n\nWarning: " + w;
   Table predicted;
   predicted.title = "Predicted errors";
   predicted.header = {"quantity", "path", "rms [um]", "max [um]"};

@@ -416,6 +416,27 @@ machine::PlantConfig linear_part(const machine::PlantConfig& plant) {
   return linear;
 }
 
+/// Issue 27 §3: a loop that diverges (a controller sampled far too slowly, ts = 1 s for a loop of
+/// hundreds of rad/s) filled the CSV with inf and nan and its notes blamed friction. Diverged: the
+/// controlled variable or the torque not finite, or the controlled variable beyond 1e12 step heights
+/// (no working loop comes near: a load step of 1e-3 N m on 1e-6 kg m^2 moves a 100 rad/s loop ~10 rad/s).
+constexpr double kDivergedSteps = 1e12;
+
+void require_bounded(const LoopRun& run, const Selector& select, double amplitude, const char* which, double ts,
+                     std::optional<double> prewarp_rad_s) {
+  const std::string design = prewarp_rad_s ? fmt::format(" (designed near {:.4g} rad/s)", *prewarp_rad_s) : "";
+  for (const DriveSample& s : run.samples) {
+    const double v = select(s);
+    if (std::isfinite(v) && std::isfinite(s.torque_command) && std::abs(v) <= kDivergedSteps * amplitude) continue;
+    throw core::InputError(
+        core::at_field("ts"),
+        fmt::format("the {} closed loop diverges (the controlled variable is {:.3g} at t = {:.6g} s): the controller{} "
+                    "is unstable on this plant sampled at ts = {} s (Nyquist {:.4g} rad/s); tune for this plant, or "
+                    "sample faster",
+                    which, v, s.t, design, ts, std::numbers::pi / ts));
+  }
+}
+
 DriveSimulation simulate_drive(const machine::PlantConfig& given_plant, const tuning::Controller& controller,
                                const DriveSimulationSettings& settings) {
   check_settings(settings);
@@ -470,8 +491,11 @@ DriveSimulation simulate_drive(const machine::PlantConfig& given_plant, const tu
       duration *= 2.0;
     }
   }
+  const std::optional<double> design_rad_s = controller.prewarp_rad_s;
+  require_bounded(linear, select, settings.amplitude, "linear", out.ts, design_rad_s);
   LoopRun nonlinear =
       run_loop(plant, out.controller, inputs, settings.test, settings.amplitude, steps, settings.torque_limit);
+  require_bounded(nonlinear, select, settings.amplitude, "simulated", out.ts, design_rad_s);
   out.metrics = metrics(nonlinear);
   out.samples = std::move(nonlinear.samples);
   out.linear_samples = std::move(linear.samples);

@@ -92,6 +92,17 @@ void simulate_axis(const AxisModelSpec& spec, Prediction& out, std::size_t i) {
 /// first command; the axes are shared among `workers` threads.
 void simulate_models(const std::array<const AxisModelSpec*, motion::kAxisCount>& by_axis, std::size_t workers,
                      Prediction& out) {
+  // Issue 27 §3: an unstable model's prediction (38 mm of "tracking error") was printed without a
+  // word; it is still simulated, so that the growth can be seen, and flagged.
+  for (motion::Axis axis : out.axes) {
+    const AxisModelSpec& spec = *by_axis[static_cast<std::size_t>(axis)];
+    if (spec.model.is_stable()) continue;
+    out.unstable.push_back(axis);
+    out.warnings.push_back(fmt::format(
+        "the model of axis {} ({}) is unstable: its predicted motion grows without bound and says nothing about the "
+        "machine (an unconstrained least-squares fit can be unstable; identify with the exact or ga method)",
+        motion::axis_name(axis), spec.source.empty() ? "no file" : spec.source));
+  }
   out.predicted.resize(out.axes.size());
   core::parallel_parts(out.axes.size(), workers, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) simulate_axis(*by_axis[static_cast<std::size_t>(out.axes[i])], out, i);

@@ -122,7 +122,7 @@ TEST_F(FrfEstimate, BadInputExitsWithThreeAndNamesWhere) {
   EXPECT_THAT(r.err, HasSubstr("(--period): no period found in the input"));
   r = run("frf estimate rec2.csv --fs 100 --input u --response y --method multisine --periods 4 -o out.csv");
   EXPECT_EQ(r.status, 3);
-  EXPECT_THAT(r.err, HasSubstr("cannot tell excited lines from the rest"));
+  EXPECT_THAT(r.err, HasSubstr("(--periods): the input does not repeat every 100 samples"));
   r = run("frf estimate rec2.csv --fs 100 --input u --response y --segment 8 -o out.csv");
   EXPECT_EQ(r.status, 3);
   EXPECT_THAT(r.err, HasSubstr("(--segment)"));

@@ -103,5 +103,36 @@ TEST_F(Hardening, ManyCloseModesGiveAShaperOrBadInput) {
   EXPECT_TRUE(fs::exists(path("s.json")));
 }
 
+// §3.12: a plant sampled at 1 s under the motor bench's controller (a loop of hundreds of rad/s)
+// wrote inf and nan into the CSV and its notes blamed friction: the diverging loop is exit 3,
+// naming ts, and nothing is written.
+TEST_F(Hardening, ADivergingSimulationIsBadInputNamingTheSamplePeriod) {
+  ASSERT_EQ(run("-q tune motor-bench -o c.json").status, 0);
+  write("slow.json", R"({"format": "servotwin.plant/1", "type": "two-mass", "motor_inertia": 0.005,
+    "load_inertia": 0.005, "stiffness": 0.5, "damping": 0.001, "motor_viscous": 0, "load_viscous": 0,
+    "coulomb": 0.01, "backlash": 0, "ts": 1.0, "noise_std": 0.01, "current_lag": 0})");
+  const Result r = run("simulate --plant slow.json --controller c.json -o s.csv");
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("slow.json (ts): the linear closed loop diverges"));
+  EXPECT_FALSE(fs::exists(path("s.csv")));
+}
+
+// §3.13: sample periods and frequencies that cannot make sense are refused by the command that
+// takes them: --ts 10 gave a 4-sample circle, --freq-hz 1e300 a shaper `shaper compare` rejected
+// blaming --accel.
+TEST_F(Hardening, SamplePeriodsAndFrequenciesOutOfAnyMachinesRangeAreRefused) {
+  write("a.nc", "G21 G90\nG01 X10 F600\nM30\n");
+  Result r = run("interpolate -p a.nc --ts 10 -o i.csv");
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("at most 0.1 s"));
+  EXPECT_EQ(run("interpolate -p a.nc --ts 0.05 -o i.csv").status, 0);
+  r = run("shaper design --type zv --freq-hz 1e300 --zeta 0.05 -o s.json");
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("(--freq-hz)"));
+  EXPECT_FALSE(fs::exists(path("s.json")));
+  EXPECT_EQ(run("shaper design --type zv --freq-hz 1e5 --zeta 0.05 -o s.json").status, 0);
+  EXPECT_EQ(run("shaper compare s.json").status, 0);
+}
+
 }  // namespace
 }  // namespace servotwin::cli_test

@@ -400,6 +400,21 @@ TEST_F(Predict, TracesThatDoNotFitTheModelsOrTheProgramAreRefused) {
   EXPECT_FALSE(std::filesystem::exists(path("p.csv")));
 }
 
+// Issue 27 §3.11: an unstable model's prediction (tens of mm of tracking error) was printed
+// without a word. It is still predicted, with a warning, and the CSV is marked before its header.
+TEST_F(Predict, AnUnstableModelIsPredictedWithAWarning) {
+  models_and_toolpath("XY", "circle");
+  json m = read_json("model_x.json");
+  m["model"]["a1"] = -m["model"]["a1"].get<double>();  // s^3 - a1 s^2 + ...: a right-half-plane pole (Routh)
+  write("unstable_x.json", m.dump());
+  const auto r = run("predict --model unstable_x.json --model model_y.json --program circle.nc --machine fadal-pid -o p.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("warning: the model of axis x (unstable_x.json) is unstable"));
+  EXPECT_THAT(slurp(path("p.csv")), testing::StartsWith("# unstable_models: x\nt,x_cmd,"));
+  ASSERT_EQ(run("predict --model model_x.json --model model_y.json --program circle.nc --machine fadal-pid -o q.csv").status, 0);
+  EXPECT_THAT(slurp(path("q.csv")), testing::StartsWith("t,x_cmd,"));
+}
+
 // Issue 27 §1.2: an axis model whose coefficients are a real model's ×1e6 (a pole at tens of MHz
 // at Ts = 1 ms) hung predict; it is refused in bounded time, naming its file and a1 (the limit is
 // rapid::AxisModel's event search, tests/rapid/test_axis_model_simulation.cpp).

@@ -210,15 +210,38 @@ TEST(Multisine, BadInputIsRejectedWithTheOptionNamed) {
   o.periods = 4;
   o.excitation_threshold_db = 3.0;
   EXPECT_EQ(field_of(o, m.x), "excitation-threshold-db");
-  // Broadband noise is no multisine: no gap between excited and other lines.
+  // Broadband noise is no multisine: it does not repeat with the period --periods gives (issue 27
+  // §3; before, it was refused later, for having no gap between excited and other lines).
   std::vector<double> noise(400);
   std::mt19937_64 rng(5);
   std::normal_distribution<double> gauss;
   for (auto& v : noise) v = gauss(rng);
   o = {};
   o.periods = 4;
-  EXPECT_EQ(field_of(o, noise), "input");
+  EXPECT_EQ(field_of(o, noise), "periods");
   EXPECT_EQ(field_of(o, std::vector<double>(400, 1.0)), "input");  // constant
+}
+
+// Issue 27 §3: --periods 7 on a record of 8 periods returned a few meaningless lines without a
+// word. Consecutive "periods" of the wrong length do not correlate: refused, naming the period
+// the input does repeat with (detect_period). A multiple of the true period is a valid layout.
+TEST(Multisine, AWrongPeriodCountIsRefusedNamingTheRightOne) {
+  const Multisine m = make_multisine(1000, 8, 1e-3, 201, two_mass, 3);
+  MultisineOptions o;
+  o.periods = 7;
+  try {
+    (void)estimate_multisine(m.x, m.y, 1e-3, o);
+    ADD_FAILURE() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().field, "periods");
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("does not repeat every 1142 samples"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("it repeats every 1000 samples"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("8 periods in the record"));
+  }
+  o.periods = 4;  // two true periods each
+  EXPECT_EQ(estimate_multisine(m.x, m.y, 1e-3, o).period_samples, 2000u);
+  o.periods = 8;
+  EXPECT_EQ(estimate_multisine(m.x, m.y, 1e-3, o).period_samples, 1000u);
 }
 
 // ---- the FdiTools two-mass motor bench (measured) -------------------------------------------

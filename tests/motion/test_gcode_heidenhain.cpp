@@ -244,6 +244,7 @@ TEST(GcodeHeidenhain, UnsupportedStatementsAreErrorsOrSkippedWithWarnings) {
 TEST(GcodeHeidenhain, MalformedNumbers) {
   EXPECT_THAT(heidenhain_error(hh("L X+1.2.3 F 100\n")), HasSubstr("t.h:2:3: malformed number in 'X+1.2.3'"));
   EXPECT_THAT(heidenhain_error(hh("L X+nan F 100\n")), HasSubstr("malformed number"));
+  EXPECT_THAT(heidenhain_error(hh("L X+10 F1e3\n")), HasSubstr("malformed number in 'F1e3': G-code numbers have no exponent"));
   EXPECT_THAT(heidenhain_error(hh("L X F 100\n")), HasSubstr("expected a number after 'X'"));
   EXPECT_THAT(heidenhain_error(hh("L X+1 X+2 F 100\n")), HasSubstr("axis X given twice"));
   EXPECT_THAT(heidenhain_error(hh("L X+1 IX+2 F 100\n")), HasSubstr("axis X given twice"));

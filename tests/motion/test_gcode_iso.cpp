@@ -351,6 +351,19 @@ TEST(GcodeIso, UnsupportedFeaturesAreErrorsOrWarnings) {
   EXPECT_EQ(p.warnings[4].message, "unexpected character '\\xff' (ignored)");
   // Malformed numbers stay errors in lenient mode.
   EXPECT_THROW(iso("G01 X1..2 F100\n", true), core::InputError);
+  // So does an exponent (issue 27 §3.9): read as F1 and an unknown word e30, F1e30 made a 1200 s
+  // move of 10 mm.
+  for (const char* exp : {"G01 X10 F1e30\n", "G01 X10 F1E+3\n", "G01 X1.5e-2 F100\n"}) {
+    try {
+      (void)iso(exp, true);
+      ADD_FAILURE() << exp;
+    } catch (const core::InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("G-code numbers have no exponent")) << exp;
+    }
+  }
+  EXPECT_THAT(iso_error("G01 X10 F1e30\n"), HasSubstr("t.nc:1:9: malformed number in 'F1e30'"));
+  // A letter E after a blank is a word of its own (unknown, a warning here).
+  EXPECT_EQ(iso("G01 X10 F100 E5\n", true).warnings.size(), 1U);
 }
 
 TEST(GcodeIso, WarningListIsCapped) {

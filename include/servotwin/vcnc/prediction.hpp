@@ -58,6 +58,9 @@ struct Prediction {
   /// What the prediction rests on that a user should know (e.g. a program that states no
   /// path-control mode); `notes` are facts (e.g. the offset of a trace from the program).
   std::vector<std::string> warnings, notes;
+  /// Axes whose model is unstable (rapid::AxisModel::is_stable): their prediction diverges; a
+  /// warning says so, and the prediction CSV and report carry it.
+  std::vector<motion::Axis> unstable;
   [[nodiscard]] std::size_t size() const noexcept { return kind.size(); }
   /// Predicted tracking error command - predicted of axis i at sample k.
   [[nodiscard]] double tracking_error(std::size_t i, std::size_t k) const noexcept {
