@@ -97,7 +97,20 @@ io::TraceProfile capture_profile(const CaptureInput& input) {
       throw core::InputError({"", 0, 0, "--delimiter"}, "expected one character (, ; |) or 'tab', got '" + input.delimiter + "'");
     }
   }
-  for (const auto& m : input.maps) r.map.push_back(io::parse_column_mapping(m));
+  std::vector<std::pair<std::string, std::string>> given;
+  for (const auto& m : input.maps) {
+    auto mapping = io::parse_column_mapping(m);
+    // One column read as two quantities (x_cmd=qm and x_act=qm) makes a capture that tracks
+    // perfectly; one quantity from two columns leaves it unclear which (issue 27 §3).
+    for (const auto& [ours, theirs] : given) {
+      if (theirs == mapping.second)
+        throw CLI::ValidationError("--map", "column '" + theirs + "' is mapped twice (" + ours + " and " + mapping.first + ")");
+      if (ours == mapping.first)
+        throw CLI::ValidationError("--map", ours + " is mapped twice (columns '" + theirs + "' and '" + mapping.second + "')");
+    }
+    given.push_back(mapping);
+    r.map.push_back(std::move(mapping));
+  }
   if (input.scale_opt != nullptr && input.scale_opt->count() > 0) {
     r.scale = input.scale;
     profile.units.clear();

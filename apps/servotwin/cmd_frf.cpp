@@ -242,7 +242,7 @@ void add_estimate(CLI::App& frf, Action& selected) {
       ->check(CLI::IsMember({"h1", "multisine"}))
       ->capture_default_str();
   cmd->add_option("--fs", a->fs, "Sample rate [Hz] for files without a time column (checked against it otherwise)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--time-column", a->time_column, "Time column (default: the first named t, time, t_<unit>, time_<unit>)");
   cmd->add_option("--max-jitter", a->max_jitter, "Largest accepted time-stamp deviation from the uniform grid, "
                                                  "relative to the sample period")

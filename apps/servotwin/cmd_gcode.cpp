@@ -174,13 +174,13 @@ void register_gcode(CLI::App& app, Action& selected) {
       ->check(CLI::IsMember({"standard", "low", "high"}))
       ->capture_default_str();
   id->moves_opt = gen->add_option("--moves", id->moves, "Number of random moves (default from --speed)")
-                      ->check(CLI::PositiveNumber);
+                      ->check(positive_number());
   id->range_opt = gen->add_option("--range", id->range, "Half-width of the motion range around the centre [mm]");
   id->feed_opt = gen->add_option("--feed", id->feed, "Programmed feed [mm/min]");
   gen->add_option("--center", id->center, "Centre of the motion range [mm], one value per axis");
   gen->add_option("--seed", id->seed, "Random seed: the same seed gives the same program")->capture_default_str();
   gen->add_option("--dialect", id->dialect, "Output dialect: iso, linuxcnc or heidenhain")
-      ->transform(CLI::CheckedTransformer(dialect_names(), CLI::ignore_case))
+      ->transform(choice_of(dialect_names()))
       ->capture_default_str();
   id->path_mode.add_to(*gen);
   gen->add_option("--name", id->name, "Program name (Heidenhain BEGIN PGM)")->capture_default_str();
@@ -202,7 +202,7 @@ void register_gcode(CLI::App& app, Action& selected) {
       ->capture_default_str();
   con->add_option("--center", contour->center, "Centre X Y [Z] [mm] (default: the origin)");
   con->add_option("--dialect", contour->options.dialect, "Output dialect: iso, linuxcnc or heidenhain")
-      ->transform(CLI::CheckedTransformer(dialect_names(), CLI::ignore_case))
+      ->transform(choice_of(dialect_names()))
       ->capture_default_str();
   contour->path_mode.add_to(*con);
   con->add_option("-o,--output", contour->output, "Output file, - for standard output")->capture_default_str();

@@ -159,7 +159,9 @@ void register_identify(CLI::App& app, Action& selected) {
                   "Command shift in samples (x_r,k := cmd[k + shift]: a controller's preview, negative for a delay), or "
                   "'auto': the shift in -3..3 whose model fits the identification data best")
       ->capture_default_str();
-  cmd->add_option("--trim-start", a->trim_start_s, "Seconds dropped at the start of each capture")->capture_default_str();
+  cmd->add_option("--trim-start", a->trim_start_s, "Seconds dropped at the start of each capture")
+      ->check(non_negative_number())
+      ->capture_default_str();
   cmd->add_option("--trim-end", a->trim_end_s, "Seconds dropped at the end of each capture")->capture_default_str();
   a->deadband_opt = cmd->add_option("--deadband", a->deadband,
                                     "Velocity deadband of the direction indicators [length/s] (default: from the data)");

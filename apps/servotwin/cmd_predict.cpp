@@ -142,12 +142,12 @@ void register_predict(CLI::App& app, Action& selected) {
   cmd->add_option("--window", a->window_s,
                   "Contour error: distance to the part of the path run within this many seconds of the commanded point")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   a->path_tolerance_opt =
       cmd->add_option("--path-tolerance", a->path_tolerance,
                       "With --command and --program: largest distance [mm] the trace's command may keep from the "
                       "programmed path (default: from the program's path-control mode)")
-          ->check(CLI::NonNegativeNumber);
+          ->check(non_negative_number());
   cmd->add_option("--offset", a->offset,
                   "With --command and --program: trace coordinates minus program coordinates, X [Y [Z]] mm "
                   "(default: none, or found from the program's end point)")

@@ -268,7 +268,7 @@ void register_simulate(CLI::App& app, Action& selected) {
   cmd->add_option("--ts", a->ts,
                   "Sample period [s] of a plant realized from a fitted model (servotwin.plant-model/1; default: the "
                   "controller's discrete period)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--plant", a->plant,
                   "Plant description (servotwin.plant/1) or flexible preset name; default: the plant the controller "
                   "was tuned from, when that was a description or preset");

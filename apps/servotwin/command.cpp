@@ -17,6 +17,31 @@
 
 namespace servotwin::cli {
 
+namespace {
+
+CLI::Validator number_at_least(double bound, bool strict, const char* name) {
+  return CLI::Validator(
+      [bound, strict](const std::string& text) -> std::string {
+        double value = 0.0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || value < bound || (strict && value == bound))
+          return fmt::format("expected a number {} {}, got '{}'", strict ? ">" : ">=", bound, text);
+        return {};
+      },
+      name);
+}
+
+}  // namespace
+
+const CLI::Validator& positive_number() {
+  static const CLI::Validator v = number_at_least(0.0, true, "POSITIVE");
+  return v;
+}
+
+const CLI::Validator& non_negative_number() {
+  static const CLI::Validator v = number_at_least(0.0, false, "NONNEGATIVE");
+  return v;
+}
+
 void check_sample_period(double ts, const std::string& option) {
   if (!std::isfinite(ts) || ts <= 0.0)
     throw core::InputError(core::at_field(option), fmt::format("expected a sample period > 0 s, got {}", ts));

@@ -3,6 +3,7 @@
 // progress messages and exit codes.
 
 #include <CLI/CLI.hpp>
+#include <cctype>
 #include <fmt/core.h>
 #include <functional>
 #include <memory>
@@ -79,6 +80,29 @@ void note_arguments(const CLI::App& app);
 void publish_outputs();
 /// Drops every output of this run that was not published (their temporary files are removed).
 void discard_outputs();
+
+/// Validators with plain messages ("expected a number > 0, got 0"; CLI11's own print a
+/// 300-digit range), for options that take a number > 0 or >= 0.
+const CLI::Validator& positive_number();
+const CLI::Validator& non_negative_number();
+
+/// Transform of a choice by name (case-insensitive) into its value, for enum options: an unknown
+/// name gives "expected one of a, b, c; got 'x'" (CLI11's CheckedTransformer prints its map).
+template <typename T>
+CLI::Validator choice_of(const std::map<std::string, T>& choices) {
+  std::string names;
+  for (const auto& [name, value] : choices) names += (names.empty() ? "" : ", ") + name;
+  return CLI::Validator(
+      [choices, names](std::string& text) -> std::string {
+        std::string key = text;
+        for (char& c : key) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        const auto found = choices.find(key);
+        if (found == choices.end()) return "expected one of " + names + "; got '" + text + "'";
+        text = std::to_string(static_cast<long long>(found->second));
+        return {};
+      },
+      names);
+}
 
 /// Throws core::InputError naming `option` unless ts is a finite sample period > 0 s.
 void check_sample_period(double ts, const std::string& option = "--ts");

@@ -2,9 +2,31 @@
 // exit statuses (0 success, 2 usage error, 3 bad input, 4 output not written, 1 internal error).
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "command.hpp"
 #include "servotwin/core/error.hpp"
+
+namespace {
+
+/// The first word that is neither a global option nor its value, when it names no subcommand
+/// ("servotwin frobnicate": CLI11 says only "A subcommand is required"); empty otherwise.
+std::string unknown_subcommand(CLI::App& app, int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word == "-j" || word == "--threads") {
+      ++i;  // its value
+      continue;
+    }
+    if (word.empty() || word[0] == '-') continue;
+    for (const CLI::App* sub : app.get_subcommands({}))
+      if (sub->check_name(word)) return {};
+    return word;
+  }
+  return {};
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace servotwin::cli;
@@ -32,6 +54,13 @@ int main(int argc, char** argv) {
                          register_tune, register_simulate})
     add(app, selected);
 
+  if (const std::string unknown = unknown_subcommand(app, argc, argv); !unknown.empty()) {
+    std::string names;
+    for (const CLI::App* sub : app.get_subcommands({})) names += (names.empty() ? "" : ", ") + sub->get_name();
+    std::fprintf(stderr, "servotwin: error: unknown subcommand '%s' (commands: %s; see servotwin --help)\n",
+                 unknown.c_str(), names.c_str());
+    return kUsageError;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

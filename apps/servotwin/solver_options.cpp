@@ -10,7 +10,7 @@ void add_solver_options(CLI::App& command, SolverInput& input) {
       {"exact", rapid::Method::Exact}, {"ga", rapid::Method::Ga}, {"ls", rapid::Method::Ls}};
   command.add_option("--method", input.method,
                      "exact: global optimum under the pole bounds; ga: the thesis's genetic algorithm; ls: unconstrained")
-      ->transform(CLI::CheckedTransformer(methods, CLI::ignore_case))
+      ->transform(choice_of(methods))
       ->capture_default_str();
   command.add_option("--p-min-hz", input.p_min_hz, "Lower bound of the real pole p [Hz] (default 0.2)");
   command.add_option("--p-max-hz", input.p_max_hz, "Upper bound of p [Hz] (default: Nyquist)");

@@ -1,6 +1,9 @@
 #include "json_reader.hpp"
 
 #include <algorithm>
+#include <set>
+#include <string>
+#include <vector>
 
 namespace servotwin::io::detail {
 
@@ -8,9 +11,67 @@ namespace {
 const char* type_name(const nlohmann::json& v) { return v.type_name(); }
 }  // namespace
 
+namespace {
+
+/// A member given twice in one object: JSON parsers keep one of them silently (nlohmann the last),
+/// so a file that says two things is refused (issue 27 §3).
+struct DuplicateKey {
+  std::string path;
+};
+
+/// Parser callback that tracks the members of every open object and the path to them.
+class DuplicateKeys {
+ public:
+  bool operator()(int /*depth*/, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    switch (event) {
+      case Event::object_start:
+        names_.push_back(pending_);
+        keys_.emplace_back();
+        pending_.clear();
+        break;
+      case Event::array_start:
+        names_.push_back(pending_);
+        keys_.emplace_back();  // never filled: arrays have no keys
+        pending_.clear();
+        break;
+      case Event::object_end:
+      case Event::array_end:
+        if (!names_.empty()) names_.pop_back();
+        if (!keys_.empty()) keys_.pop_back();
+        break;
+      case Event::key: {
+        pending_ = parsed.get<std::string>();
+        if (!keys_.empty() && !keys_.back().insert(pending_).second) throw DuplicateKey{path_to(pending_)};
+        break;
+      }
+      case Event::value:
+        pending_.clear();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  [[nodiscard]] std::string path_to(const std::string& key) const {
+    std::string out;
+    for (const std::string& name : names_)
+      if (!name.empty()) out += name + ".";
+    return out + key;
+  }
+  std::vector<std::string> names_;
+  std::vector<std::set<std::string>> keys_;
+  std::string pending_;
+};
+
+}  // namespace
+
 nlohmann::json parse_json_text(std::string_view text, std::string_view source_name) {
   try {
-    return nlohmann::json::parse(text.begin(), text.end());
+    return nlohmann::json::parse(text.begin(), text.end(), DuplicateKeys{});
+  } catch (const DuplicateKey& d) {
+    throw core::InputError({std::string(source_name), 0, 0, d.path},
+                           "the member is given twice in one object (a JSON reader would keep only one of them)");
   } catch (const nlohmann::json::parse_error& e) {
     // e.byte is 1-based and points just past the problem; convert it to line and column.
     const std::size_t byte = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());

@@ -249,6 +249,10 @@ LoadedAxisModel parse_axis_model_json(std::string_view text, std::string_view so
   const json document = detail::parse_json_text(text, source_name);
   check_format(document, kAxisModelFormat, source_name);
   const JsonObject root(document, "", source_name);
+  // Every member axis_model_to_json writes; anything else is a misspelling (issue 27 §3).
+  root.allow_only({"format", "axis", "ts", "length_unit", "model", "theta", "search", "poles", "zeros", "stable",
+                   "bandwidth_hz", "bounds", "feasible", "active_constraints", "kkt_case", "objective", "lower_bound",
+                   "solver", "regressors", "warnings", "sources", "shift_search", "refinement", "fit", "validation"});
   const JsonObject m = root.object("model");
   m.allow_only({"a1", "a2", "a3", "b0", "b1", "b2", "d0", "d1"});
   rapid::ModelCoefficients c;
@@ -263,7 +267,10 @@ LoadedAxisModel parse_axis_model_json(std::string_view text, std::string_view so
   const double ts = root.number("ts");
   if (!(ts > 0.0)) root.fail("ts", "sample period must be > 0");
   const std::string axis = root.string("axis");
-  if (axis.empty()) root.fail("axis", "expected an axis name");
+  if (axis.size() != 1 || std::string_view("xyzabc").find(axis.front()) == std::string_view::npos)
+    root.fail("axis", "expected an axis name x, y, z, a, b or c, found " +
+                          (axis.size() > 20 ? json(axis.substr(0, 20)).dump() + "... (" + std::to_string(axis.size()) + " characters)"
+                                            : json(axis).dump()));
   std::string method;
   if (auto solver = root.optional_object("solver")) method = solver->string_or("method", "");
   int shift = 0;

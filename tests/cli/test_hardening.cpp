@@ -134,5 +134,28 @@ TEST_F(Hardening, SamplePeriodsAndFrequenciesOutOfAnyMachinesRangeAreRefused) {
   EXPECT_EQ(run("shaper compare s.json").status, 0);
 }
 
+// §3.14: option values out of range named the bound in 300 digits or printed a wrapped size_t,
+// an unknown method the transformer's map, an unknown subcommand "A subcommand is required".
+TEST_F(Hardening, OptionErrorsArePlain) {
+  const auto error_of = [&](const std::string& args) {
+    const Result r = run(args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.err;
+    return r.err;
+  };
+  write("a.nc", "G21 G90\nG01 X10 F600\nM30\n");
+  write("c.csv", "t,x_cmd,x_act\n0,0,0\n0.001,0.1,0.05\n");
+  EXPECT_THAT(error_of("identify c.csv --trim-start -1"), HasSubstr("--trim-start: expected a number >= 0, got '-1'"));
+  EXPECT_THAT(error_of("gcode identification --moves 0"), HasSubstr("--moves: expected a number > 0, got '0'"));
+  EXPECT_THAT(error_of("frf estimate c.csv --input x_cmd --response x_act --fs 0"), HasSubstr("expected a number > 0"));
+  EXPECT_THAT(error_of("identify c.csv --method foo"), HasSubstr("--method: expected one of exact, ga, ls; got 'foo'"));
+  EXPECT_THAT(error_of("gcode contour --dialect fanuc"), HasSubstr("expected one of heidenhain, iso, linuxcnc; got 'fanuc'"));
+  EXPECT_THAT(error_of("frobnicate"), HasSubstr("unknown subcommand 'frobnicate'"));
+  EXPECT_THAT(error_of("-j 2 frobnicate"), HasSubstr("unknown subcommand 'frobnicate'"));
+  // Case does not matter for a choice.
+  EXPECT_EQ(run("gcode contour --dialect LinuxCNC -o c.ngc").status, 0);
+  // §3.15: one column read as two quantities.
+  EXPECT_THAT(error_of("import c.csv --map x_cmd=x_act --map x_act=x_act"), HasSubstr("column 'x_act' is mapped twice"));
+}
+
 }  // namespace
 }  // namespace servotwin::cli_test

@@ -202,6 +202,25 @@ TEST(RapidJson, ModelFileErrors) {
   EXPECT_THAT(err(R"({"format": "servotwin.axis-model/1", "axis": "x", "ts": -1,
                      "model": {"a1": 1, "a2": 1, "a3": 1, "b0": 0, "b1": 0, "b2": 1, "d0": 0, "d1": 0}})"),
               HasSubstr("(ts)"));
+  // Issue 27 §3.15: unknown members, axes that are none of the machine's, and a member given twice
+  // (nlohmann keeps the last) are errors.
+  const std::string coefficients = R"("model": {"a1": 1, "a2": 1, "a3": 1, "b0": 0, "b1": 0, "b2": 1, "d0": 0, "d1": 0})";
+  EXPECT_THAT(err(R"({"format": "servotwin.axis-model/1", "axis": "x", "ts": 0.001, "colour": 1, )" + coefficients + "}"),
+              HasSubstr("m.json (colour): unknown field"));
+  EXPECT_THAT(err(R"({"format": "servotwin.axis-model/1", "axis": "q", "ts": 0.001, )" + coefficients + "}"),
+              HasSubstr("m.json (axis): expected an axis name x, y, z, a, b or c, found \"q\""));
+  EXPECT_THAT(err(R"({"format": "servotwin.axis-model/1", "axis": ")" + std::string(1000000, 'x') + R"(", "ts": 0.001, )" +
+                  coefficients + "}"),
+              HasSubstr("(1000000 characters)"));
+  EXPECT_THAT(err(R"({"format": "servotwin.axis-model/1", "axis": "x", "ts": 0.001, )" + coefficients + R"(, "ts": 0.002})"),
+              HasSubstr("m.json (ts): the member is given twice"));
+  EXPECT_THAT(err(R"({"format": "servotwin.axis-model/1", "axis": "x", "ts": 0.001,
+                     "model": {"a1": 1, "a2": 1, "a3": 1, "b0": 0, "b1": 0, "b2": 1, "d0": 0, "d1": 0, "a1": 2}})"),
+              HasSubstr("m.json (model.a1): the member is given twice"));
+  // The same key in two objects is no duplicate.
+  EXPECT_EQ(err(R"({"format": "servotwin.axis-model/1", "axis": "x", "ts": 0.001, "fit": {"rms": 1},
+                   "validation": {"rms": 2}, )" + coefficients + "}"),
+            "no error");
 }
 
 }  // namespace rapid_json_test
