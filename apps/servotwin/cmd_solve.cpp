@@ -27,6 +27,7 @@ int run(const SolveArgs& a, const GlobalOptions& global) {
   record.bounds = vcnc::complete_bounds(settings.bounds, record.ts);
   record.regressors.command_shift = stats.command_shift;
   record.solution = rapid::solve(stats.problem, settings.method, record.bounds, settings.solve);
+  record.solution.warnings.insert(record.solution.warnings.begin(), stats.warnings.begin(), stats.warnings.end());
   record.sources = a.statistics;
   print_model_summary(record);
   if (!a.output.empty()) {

@@ -35,6 +35,7 @@ json fit_to_json(const rapid::FitMetrics& f) {
     j["reading_quantum"] = f.reading_quantum;
     j["quantization_floor"] = f.quantization_floor;
   }
+  if (f.diverged) j["diverged_at_sample"] = f.diverged_at;
   return j;
 }
 
@@ -134,7 +135,9 @@ LoadedStatistics load_statistics(const std::vector<std::string>& paths) {
                                  " (" + paths.front() + "): rebuild them with the same --shift");
     }
     try {
-      const auto one = rapid::RegressionProblem::from_normal_equations(ne);
+      std::vector<std::string> repairs;
+      const auto one = rapid::RegressionProblem::from_normal_equations(ne, &repairs);
+      for (const std::string& r : repairs) total.warnings.push_back(path + ": " + r);
       if (total.problem.empty()) total.problem = one;
       else total.problem.merge(one);
     } catch (const core::InputError& e) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -196,8 +197,11 @@ class ComparisonSink final : public PositionSink {
       const double measured = record_.command[k] - record_.actual[k];
       const double predicted = record_.command[k] - positions[j];
       if (!std::isfinite(predicted)) {
-        throw core::InputError(core::at_field("predicted_error[" + std::to_string(sums_.offset + k) + "]"),
-                               "tracking error sample must be finite (an unstable model's prediction diverges)");
+        // Issue 27 §3: an unstable model (identify --method ls) ended identify with exit 3 here;
+        // its fit is reported as diverged instead, and the model is still written.
+        diverged_ = true;
+        diverged_at_ = sums_.offset + k;
+        return false;
       }
       sums_.add(measured, predicted);
     }
@@ -205,12 +209,16 @@ class ComparisonSink final : public PositionSink {
     return !gave_up_;
   }
   [[nodiscard]] bool gave_up() const { return gave_up_; }
+  [[nodiscard]] bool diverged() const { return diverged_; }
+  [[nodiscard]] std::size_t diverged_at() const { return diverged_at_; }
 
  private:
   const TrackingRecord& record_;
   RunningComparison& sums_;
   double give_up_norm_;
   bool gave_up_ = false;
+  bool diverged_ = false;
+  std::size_t diverged_at_ = 0;
 };
 
 }  // namespace
@@ -252,17 +260,32 @@ FitMetrics simulation_fit(const AxisModel& model, std::span<const TrackingRecord
 
   RunningComparison sums;
   bool gave_up = false;
+  std::optional<std::size_t> diverged_at;
   for (const TrackingRecord& r : records) {
     ModelSimulationOptions o = options;
     if (!o.initial_position) o.initial_position = r.actual.front();
     ComparisonSink sink(r, sums, give_up_norm);
     (void)model.simulate_blocks(r.command, o, sink);
     sums.offset += r.command.size();
-    if ((gave_up = sink.gave_up())) break;
+    if (sink.diverged()) diverged_at = sink.diverged_at();
+    if ((gave_up = sink.gave_up() || sink.diverged())) break;
   }
 
   FitMetrics m = sums.metrics(n, deviation, constant);
   m.complete = !gave_up;
+  if (diverged_at) {
+    // The sums cover the samples before the divergence: their RMS values are over those.
+    const double covered = static_cast<double>(std::max<std::size_t>(*diverged_at, 1));
+    const double scale = std::sqrt(count / covered);
+    m.rms_measured *= scale;
+    m.rms_predicted *= scale;
+    m.rms_difference *= scale;
+    m.samples = *diverged_at;
+    m.diverged = true;
+    m.diverged_at = *diverged_at;
+    m.nrmse = std::numeric_limits<double>::infinity();
+    m.fit_percent = -std::numeric_limits<double>::infinity();
+  }
   return m;
 }
 

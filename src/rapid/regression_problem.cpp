@@ -5,7 +5,11 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
 
 #include "regression_qr.hpp"
 #include "servotwin/core/error.hpp"
@@ -166,7 +170,33 @@ RegressionProblem::RegressionProblem(const Matrix9& factor, std::uint64_t sample
   detail::make_diagonal_nonnegative(u_);
 }
 
-RegressionProblem RegressionProblem::from_normal_equations(const NormalEquations& ne) {
+namespace {
+
+/// R^T P^+ R of the scaled augmented matrix c (unit diagonal: Gamma's entry is 1), the least
+/// Gamma (relative to the given one) for which [P R; R^T Gamma] is semidefinite; empty when R lies
+/// outside the range of P beyond rounding (then no Gamma helps: the objective is unbounded below).
+std::optional<double> least_relative_gamma(const Matrix9& c) {
+  const Eigen::Matrix<double, kParameterCount, kParameterCount> p = c.topLeftCorner<kParameterCount, kParameterCount>();
+  const Vector8 r = c.topRightCorner<kParameterCount, 1>();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kParameterCount, kParameterCount>> eigen(p);
+  const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
+  const double tolerance = 1e-10 * std::max(largest, 1.0);
+  double q = 0.0;
+  Vector8 outside = r;
+  for (int i = 0; i < kParameterCount; ++i) {
+    const double lambda = eigen.eigenvalues()(i);
+    if (lambda <= tolerance) continue;
+    const double projection = eigen.eigenvectors().col(i).dot(r);
+    q += projection * projection / lambda;
+    outside -= projection * eigen.eigenvectors().col(i);
+  }
+  if (outside.norm() > 1e-8 * std::max(r.norm(), 1.0)) return std::nullopt;
+  return q;
+}
+
+}  // namespace
+
+RegressionProblem RegressionProblem::from_normal_equations(const NormalEquations& ne, std::vector<std::string>* warnings) {
   validate_statistics(ne);
   const Matrix9 g = augmented_gram(ne);
   // Symmetric scaling to unit diagonal: the factorization then sees the correlation structure
@@ -193,8 +223,26 @@ RegressionProblem RegressionProblem::from_normal_equations(const NormalEquations
   }
   const PivotedCholesky chol = pivoted_cholesky(c, kAugmentedColumns);
   if (chol.indefinite) {
-    throw field_error("Gamma", "[P R; R^T Gamma] is indefinite beyond rounding (Gamma < R^T P^+ R, or R outside "
-                               "the range of P): not the statistics of any data");
+    // Issue 27 §3.17: a Gamma printed with two decimals falls below R^T P^+ R; the minimizer does
+    // not depend on Gamma, so such statistics are solved with Gamma raised to the least consistent
+    // value (and a warning), and only an R outside P's range is refused.
+    const std::optional<double> least = least_relative_gamma(c);
+    if (warnings != nullptr && least && *least >= 1.0) {
+      NormalEquations raised = ne;
+      raised.gamma = ne.gamma * *least * (1.0 + 1e-8);
+      RegressionProblem problem = from_normal_equations(raised, nullptr);
+      warnings->push_back("objective shifted: Gamma = " + std::to_string(ne.gamma) + " is below R^T P^+ R = " +
+                          std::to_string(ne.gamma * *least) + ", inconsistent with P and R" +
+                          (*least < 1.01 ? " (probably rounded)" : " by more than rounding explains: check the statistics") +
+                          "; solved with the least consistent Gamma, which leaves the minimizer unchanged and the "
+                          "objective's level unknown");
+      return problem;
+    }
+    throw field_error(least ? "Gamma" : "R",
+                      least ? "[P R; R^T Gamma] is indefinite beyond rounding (Gamma < R^T P^+ R): not the statistics "
+                              "of any data"
+                            : "lies outside the range of P beyond rounding: the objective has no minimum; not the "
+                              "statistics of any data");
   }
   // C = Pi L L^T Pi^T, so G = M^T M with M = L^T Pi^T S; M is re-triangularized by Householder
   // reflections into the canonical upper-triangular factor in the original column order.

@@ -1,5 +1,7 @@
 #include "servotwin/vcnc/identification.hpp"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <limits>
@@ -267,6 +269,13 @@ AxisIdentification identify_axis(const std::vector<NamedCapture>& captures, cons
       if (*fit) rapid::set_reading_quantum(**fit, validation_quantum);
   }
   for (const auto& c : captures) result.sources.push_back(c.source);
+  for (const auto& [fit, what] : {std::pair{&result.fit, "identification"}, std::pair{&result.validation, "validation"}})
+    if (*fit && (*fit)->diverged)
+      result.solution.warnings.push_back(fmt::format(
+          "the model is unstable: its simulated tracking error on the {} captures diverges at sample {} (the fit covers "
+          "the samples before it); an unconstrained least-squares model can be unstable, the bounded methods (exact, "
+          "ga) are not",
+          what, (*fit)->diverged_at));
   return result;
 }
 

@@ -152,6 +152,32 @@ TEST(AxisModelMetrics, PooledRecordsAndTheGiveUpBound) {
   EXPECT_EQ(kept.nrmse, by_hand.nrmse);
 }
 
+TEST(AxisModelMetrics, AnUnstableModelsFitIsReportedAsDiverged) {
+  // Issue 27 §3.16: an unstable model's simulation overflows; identify ended with exit 3 ("tracking
+  // error sample must be finite"). The fit says where it diverged, covers the samples before, and
+  // its nrmse is +inf. Reference: the same model simulated by hand first leaves the finite
+  // numbers at that sample.
+  const AxisModel truth(test::reference_model("pid_x_actual"), kTs);
+  ModelCoefficients c = test::reference_model("pid_x_actual");
+  c.a1 = -5.0 * c.a1;  // s^3 + a1 s^2 + ...: a right-half-plane pair of about 500 rad/s (Routh)
+  const AxisModel unstable(c, kTs);
+  ASSERT_FALSE(unstable.is_stable());
+  const std::vector<double> command = test::back_and_forth(8.0, 120.0, 1500.0, kTs, 0.1, 3);
+  const std::vector<double> actual = truth.simulate(command).position;
+  const FitMetrics fit = simulation_fit(unstable, command, actual);
+  EXPECT_TRUE(fit.diverged);
+  EXPECT_FALSE(fit.complete);
+  EXPECT_EQ(fit.nrmse, std::numeric_limits<double>::infinity());
+  ModelSimulationOptions o;
+  o.initial_position = actual.front();
+  const ModelResponse by_hand = unstable.simulate(command, o);
+  const auto first_bad = std::find_if(by_hand.tracking_error.begin(), by_hand.tracking_error.end(),
+                                      [](double e) { return !std::isfinite(e); });
+  ASSERT_NE(first_bad, by_hand.tracking_error.end());
+  EXPECT_EQ(fit.diverged_at, static_cast<std::size_t>(first_bad - by_hand.tracking_error.begin()));
+  EXPECT_EQ(fit.samples, fit.diverged_at);
+}
+
 /// A slow sine sampled at 1 kHz: positions that pass every count of a grid many times.
 std::vector<double> sine_positions(double amplitude, double offset) {
   std::vector<double> x(5000);

@@ -218,6 +218,37 @@ TEST(RegressionProblem, FromNormalEquationsRejectsBadInput) {
   expect_field_error(ne, "R", "indefinite");
 }
 
+TEST(RegressionProblem, AGammaBelowTheLeastSquaresFitIsRaisedWithAWarning) {
+  // Issue 27 §3.17: statistics printed with two decimals (the thesis's appendix) can put Gamma below
+  // R^T P^+ R. The minimizer of 1/2 theta^T P theta - R^T theta does not depend on Gamma: with a
+  // warnings list the problem is solved, the objective's minimizer is that of the true statistics
+  // (reference: P^-1 R by LDL^T), and the objective at it is ~0 (Gamma raised to the least value).
+  const NormalEquations truth = valid_statistics();
+  NormalEquations rounded = truth;
+  const Vector8 minimizer = truth.P.ldlt().solve(truth.R);
+  rounded.gamma = 0.5 * truth.R.dot(minimizer);
+  std::vector<std::string> warnings;
+  const RegressionProblem repaired = RegressionProblem::from_normal_equations(rounded, &warnings);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings.front().find("objective shifted"), std::string::npos) << warnings.front();
+  const NormalEquations back = repaired.normal_equations();
+  const Vector8 again = back.P.ldlt().solve(back.R);
+  EXPECT_LT((again - minimizer).norm(), 1e-8 * minimizer.norm());
+  EXPECT_LT(repaired.objective(minimizer), 1e-6 * truth.gamma);
+  // Without a warnings list the strict reading stays; an R outside P's range has no minimizer.
+  EXPECT_THROW((void)RegressionProblem::from_normal_equations(rounded), core::InputError);
+  NormalEquations outside = truth;
+  outside.P.row(6).setZero();
+  outside.P.col(6).setZero();
+  outside.R(6) = 1.0;
+  try {
+    (void)RegressionProblem::from_normal_equations(outside, &warnings);
+    FAIL() << "expected InputError";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.where().field, "R") << e.what();
+  }
+}
+
 TEST(RegressionProblem, ConstructorRejectsBadFactors) {
   Matrix9 u = reference_factor(random_rows(30, 13));
   EXPECT_THROW(RegressionProblem(u, 30, -0.001), core::InputError);

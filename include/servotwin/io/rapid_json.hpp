@@ -36,6 +36,9 @@ struct LoadedStatistics {
   rapid::RegressionProblem problem;
   std::string axis;  ///< common "axis" of the files (empty when none says)
   int command_shift = 0;  ///< common "command_shift" of the files
+  /// Repairs made while reading, each naming its file (a Gamma below R^T P^+ R: see
+  /// rapid::RegressionProblem::from_normal_equations).
+  std::vector<std::string> warnings;
 };
 /// Reads and adds up several statistics files; core::InputError naming the file whose Ts, axis or
 /// command shift differs from the first's.

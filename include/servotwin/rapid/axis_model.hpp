@@ -214,6 +214,10 @@ struct FitMetrics {
   std::size_t samples = 0;
   /// false: simulation_fit gave up early (see there); nrmse is then a lower bound.
   bool complete = true;
+  /// The simulated positions stopped being finite numbers at sample `diverged_at` (an unstable
+  /// model's prediction diverges): the other members cover the samples before it, nrmse is +inf.
+  bool diverged = false;
+  std::size_t diverged_at = 0;
 };
 
 /// The count of the grid `positions` lie on: the smallest gap between distinct values, accepted

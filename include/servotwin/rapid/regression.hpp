@@ -115,7 +115,11 @@ class RegressionProblem {
   /// core::InputError (field "P", "R", "Gamma", "N" or "Ts") for non-finite entries, asymmetry
   /// beyond 1e-10 relative to sqrt(P_ii P_jj), a negative diagonal or Gamma, indefiniteness beyond
   /// rounding (a remaining scaled Schur complement entry above 1e-9), N = 0, ts not finite and > 0.
-  static RegressionProblem from_normal_equations(const NormalEquations& ne);
+  /// With `warnings`, a Gamma below R^T P^+ R (statistics printed with few digits, as in the
+  /// thesis's appendix) is raised to it and a warning appended instead: the minimizer of
+  /// 1/2 theta^T P theta - R^T theta does not depend on Gamma, only the objective's level does. Still
+  /// refused: an R outside the range of P, where the objective has no minimum.
+  static RegressionProblem from_normal_equations(const NormalEquations& ne, std::vector<std::string>* warnings = nullptr);
 
   /// P = U11^T U11, R = U11^T u12, Gamma = U^T U's last diagonal entry; exactly symmetric P.
   [[nodiscard]] NormalEquations normal_equations() const;
