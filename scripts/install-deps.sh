@@ -3,8 +3,9 @@
 #   scripts/install-deps.sh          build dependencies (compiler, CMake, Eigen, CLI11, fmt, JSON, GLPK, and
 #                                    npm, which fetches the charting library of the HTML reports)
 #   scripts/install-deps.sh --test   plus GoogleTest/GoogleMock, Google Benchmark, Chromium (the
-#                                    reports are checked in headless Chromium) and LinuxCNC (the
-#                                    integration test runs servotwin's programs on it)
+#                                    reports are checked in headless Chromium), LinuxCNC (the
+#                                    integration test runs servotwin's programs on it) and clang
+#                                    (the fuzz smoke stage builds the libFuzzer targets)
 #   scripts/install-deps.sh --fuzz   plus clang for the libFuzzer targets
 set -euo pipefail
 
@@ -14,7 +15,7 @@ packages=(g++ make cmake libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-de
 command -v npm >/dev/null || packages+=(npm)
 for arg in "$@"; do
   case "$arg" in
-    --test) packages+=(libgtest-dev libgmock-dev libbenchmark-dev python3 chromium linuxcnc-uspace) ;;
+    --test) packages+=(libgtest-dev libgmock-dev libbenchmark-dev python3 chromium linuxcnc-uspace clang libclang-rt-dev) ;;
     --fuzz) packages+=(clang libclang-rt-dev) ;;
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 2 ;;
   esac

@@ -1,0 +1,9 @@
+// libFuzzer target for the shaper reader (issue 27 §5; contract in reader_harnesses.hpp):
+// cmake --preset fuzz && cmake --build --preset fuzz, then
+// build/fuzz/fuzz/fuzz_shaper fuzz/corpus/shaper -max_total_time=60
+#include "reader_harnesses.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  servotwin::fuzz::shaper_one_input(data, size);
+  return 0;
+}
