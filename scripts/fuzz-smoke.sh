@@ -1,14 +1,27 @@
 #!/usr/bin/env bash
 # Fuzz smoke stage of the test command (issue 27 §5): builds every libFuzzer target with clang
-# (preset "fuzz": address + undefined sanitizers, the libraries instrumented) and runs each for a
-# bounded time on a scratch copy of its corpus; any crash, leak, timeout or out-of-memory fails the
-# stage, and libFuzzer leaves the input in build/fuzz/artifacts/. Longer runs for development:
-#   build/fuzz/fuzz/fuzz_plant fuzz/corpus/plant -max_total_time=600
-#   scripts/fuzz-smoke.sh [seconds per target, default 10]
+# (preset "fuzz": address + undefined sanitizers, the readers instrumented) and runs each for a
+# fixed number of inputs from a fixed seed, starting from its committed corpus only. The same
+# commit therefore explores the same inputs on every machine: a finding fails the stage here and
+# in CI alike, and libFuzzer leaves the input in build/fuzz/artifacts/ (add it to
+# tests/data/io/fuzz_regressions/<reader>/ with the fix). Open-ended runs for development:
+#   build/fuzz/fuzz/fuzz_plant build/fuzz/work/plant fuzz/corpus/plant -max_total_time=600
+#   scripts/fuzz-smoke.sh [inputs per target, default 20000]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seconds=${1:-10}
-cmake --preset fuzz >/dev/null
+runs=${1:-20000}
+case "$runs" in
+  '' | *[!0-9]*) echo "fuzz-smoke.sh: the number of inputs must be a positive integer, got '$runs'" >&2; exit 2 ;;
+esac
+# The modules the fuzzers do not look into come from the release build when there is one (brought
+# up to date first), instead of being compiled a second time (fuzz/CMakeLists.txt).
+prebuilt=
+if [ -f build/release/CMakeCache.txt ]; then
+  modules=$(sed -n 's/.*"SERVOTWIN_PREBUILT_MODULES": "\([^"]*\)".*/\1/p' CMakePresets.json)
+  cmake --build --preset release --target $(printf 'servotwin_%s ' ${modules//;/ }) >/dev/null
+  prebuilt=$PWD/build/release/src
+fi
+cmake --preset fuzz -DSERVOTWIN_PREBUILT_DIR="$prebuilt" >/dev/null
 cmake --build --preset fuzz
 artifacts=build/fuzz/artifacts
 mkdir -p "$artifacts"
@@ -18,14 +31,14 @@ for target in build/fuzz/fuzz/fuzz_*; do
   name=${target##*/fuzz_}
   corpus=fuzz/corpus/$name
   [ "$name" = interpolation ] && corpus=fuzz/corpus/gcode  # the G-code seeds, through the interpolator
-  work=build/fuzz/work/$name
-  mkdir -p "$work"
+  work=build/fuzz/smoke/$name  # emptied: what earlier runs found would make this run differ
+  rm -rf "$work" && mkdir -p "$work"
   dict=()
   [ "$name" = gcode ] || [ "$name" = interpolation ] && dict=(-dict=fuzz/gcode.dict)
   # New inputs go to the scratch folder (first); the committed seeds (second) are only read.
-  if "$target" "$work" "$corpus" "${dict[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  if "$target" "$work" "$corpus" "${dict[@]}" -seed=1 -runs="$runs" -reload=0 -max_total_time=300 -timeout=10 -rss_limit_mb=2048 \
        -artifact_prefix="$artifacts/${name}-" -print_final_stats=0 > "build/fuzz/$name.log" 2>&1; then
-    echo "fuzz_$name: $(grep -Eo 'Done [0-9]+ runs in [0-9]+ second' "build/fuzz/$name.log" | tail -n 1 || true)s, no finding"
+    echo "fuzz_$name: $(grep -Eo 'Done [0-9]+ runs in [0-9]+ second' "build/fuzz/$name.log" | tail -n 1 || true)(s), no finding"
   else
     echo "fuzz_$name: FAILED (log: build/fuzz/$name.log, input: $artifacts/${name}-*)"
     tail -30 "build/fuzz/$name.log"

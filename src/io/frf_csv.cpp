@@ -61,6 +61,10 @@ void parse_comment(std::string_view line, std::size_t line_number, const std::st
     const std::string_view freq = trim_blanks(key.substr(8, key.size() - 11));
     const double f = detail::parse_number(Field{freq, static_cast<std::size_t>(freq.data() - line.data()) + 1},
                                           {source, line_number, 0, "invalid"}, "invalid");
+    // The note is written back on one comment line, so a line break inside it cannot be kept.
+    if (const std::size_t cr = value.find('\r'); cr != std::string_view::npos)
+      throw core::InputError({source, line_number, value_column + cr, "invalid"},
+                             "a carriage return inside the note of an invalid point; end lines with LF or CR LF");
     preamble.invalid_notes.emplace_back(f, std::string(value));
   } else if (key == "duration_s") {
     const double d = detail::parse_number(Field{value, value_column}, {source, line_number, 0, ""}, "duration_s");

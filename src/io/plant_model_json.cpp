@@ -204,7 +204,9 @@ LoadedPlantModel parse_plant_model_json(std::string_view text, std::string_view 
     model.delay_s = *delay;
   }
 
-  const json& modes = document.at("modes");
+  // Not JsonObject::array: a rigid-body model has an empty list of modes.
+  if (!document.contains("modes")) root.fail("modes", "missing required field");
+  const json& modes = document["modes"];
   if (!modes.is_array()) root.fail("modes", "expected an array");
   // A motor-side mode is an antiresonance entry and a resonance entry, a load-side one a resonance.
   const std::size_t per_mode = load ? 1 : 2;

@@ -81,7 +81,8 @@ bool TraceTable::read_line() {
     if (kept > 0 && begin_ > 0) std::memmove(buffer_.data(), start, kept);
     begin_ = 0;
     filled_ = kept;
-    if (buffer_.size() < kBlock) buffer_.resize(kBlock);
+    if (buffer_.empty()) buffer_.resize(kFirstBlock);
+    else if (buffer_.size() < kBlock) buffer_.resize(kBlock);
     else if (filled_ == buffer_.size()) buffer_.resize(2 * buffer_.size());
     in_.read(buffer_.data() + filled_, static_cast<std::streamsize>(buffer_.size() - filled_));
     filled_ += static_cast<std::size_t>(in_.gcount());

@@ -48,7 +48,10 @@ class TraceTable {
   const CaptureReadOptions& options_;
   // Lines are cut from a block buffer (one read of kBlock bytes instead of one getline per line:
   // issue 26, captures of hundreds of MB); line_ points into it until the next read_line.
+  // The first read is smaller: most files a user hands over by mistake, the fuzzers' inputs and
+  // short captures fit in it, and sizing 1 MiB for them was most of the time to read them.
   static constexpr std::size_t kBlock = std::size_t{1} << 20;
+  static constexpr std::size_t kFirstBlock = std::size_t{1} << 16;
   std::string buffer_;
   std::size_t begin_ = 0, filled_ = 0;  ///< unread bytes are buffer_[begin_, filled_)
   bool end_of_input_ = false;
