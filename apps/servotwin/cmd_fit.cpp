@@ -47,11 +47,12 @@ void print_summary(const std::string& source, const fit::FitReport& r) {
   const fit::PlantModel& m = f.model;
   fmt::print("{}: {} points, {} output ({})\n", source, f.points, fit::to_string(m.output), r.output.note);
   if (!r.left_out.empty()) {
-    fmt::print("left out {} point(s) (marked invalid by the measurement, or outliers of the first fit):\n", r.left_out.size());
+    fmt::print("left out {} {} (marked invalid by the measurement, or outliers of the first fit):\n", r.left_out.size(),
+               plural(r.left_out.size(), "point", "points"));
     for (const std::string& why : r.left_out) fmt::print("  {}\n", why);
   }
-  fmt::print("model: {} {}mode(s), rigid {}{}{}; {}\n", m.modes.size(), m.sensor == fit::SensorSide::kLoad ? "load-side " : "",
-             fit::to_string(m.rigid),
+  fmt::print("model: {} {}{}, rigid {}{}{}; {}\n", m.modes.size(), m.sensor == fit::SensorSide::kLoad ? "load-side " : "",
+             plural(m.modes.size(), "mode", "modes"), fit::to_string(m.rigid),
              m.lag_pole_rad_s ? ", lag pole" : "", m.delay_s ? ", delay" : "", r.selection.criterion);
   if (r.selection.method == "auto")
     for (const auto& c : r.selection.candidates)

@@ -337,7 +337,8 @@ void print_measurement(const std::string& plant_name, const vcnc::FrfExperiment&
                p.omega / (2.0 * std::numbers::pi), std::abs(p.response), p.thd);
   }
   const auto unsettled = std::count_if(e.points.begin(), e.points.end(), [](const frf::MeasuredPoint& p) { return !p.settled; });
-  if (unsettled > 0) fmt::print("  {} point(s) latched at the settling-time limit without converging\n", unsettled);
+  if (unsettled > 0) fmt::print("  {} {} latched at the settling-time limit without converging\n", unsettled,
+                              plural(unsettled, "point", "points"));
   for (const core::FrequencyPoint& p : e.response.points)
     if (!p.valid) fmt::print("  invalid at {:.4g} Hz, left out of fits: {}\n", p.freq_hz, p.note);
 }

@@ -90,7 +90,7 @@ struct ProgramArgs {
   std::string output = "-";
 };
 
-std::string plural(std::size_t n, const char* word) { return fmt::format("{} {}{}", n, word, n == 1 ? "" : "s"); }
+std::string counted(std::size_t n, const char* word) { return fmt::format("{} {}{}", n, word, n == 1 ? "" : "s"); }
 
 /// The modes the motion blocks run in, in order of first use, with their block counts.
 std::string path_control_summary(const motion::Program& program) {
@@ -107,7 +107,7 @@ std::string path_control_summary(const motion::Program& program) {
   }
   if (modes.empty()) return "no motion";
   std::string out;
-  for (const auto& [text, count] : modes) out += (out.empty() ? "" : "; ") + text + " (" + plural(count, "motion block") + ")";
+  for (const auto& [text, count] : modes) out += (out.empty() ? "" : "; ") + text + " (" + counted(count, "motion block") + ")";
   return out;
 }
 
@@ -116,10 +116,10 @@ int run_check(const ProgramArgs& a, const GlobalOptions& /*global*/) {
   std::map<motion::BlockType, std::size_t> counts;
   for (const auto& b : program.blocks) ++counts[b.type];
   fmt::print("{}: {} program, {}: {}, {}, {}, {}\n", a.program.path, dialect_title(program.dialect),
-             plural(program.blocks.size(), "block"),
-             plural(counts[motion::BlockType::Rapid], "rapid move"), plural(counts[motion::BlockType::Linear], "line"),
-             plural(counts[motion::BlockType::ArcCw] + counts[motion::BlockType::ArcCcw], "arc"),
-             plural(counts[motion::BlockType::Dwell], "dwell"));
+             counted(program.blocks.size(), "block"),
+             counted(counts[motion::BlockType::Rapid], "rapid move"), counted(counts[motion::BlockType::Linear], "line"),
+             counted(counts[motion::BlockType::ArcCw] + counts[motion::BlockType::ArcCcw], "arc"),
+             counted(counts[motion::BlockType::Dwell], "dwell"));
   // The plan gives the true path (arcs included) and a cycle time at the default CNC limits.
   const motion::InterpolationLimits limits;
   const motion::MotionPlan plan = motion::plan_motion(program, limits);
@@ -131,7 +131,7 @@ int run_check(const ProgramArgs& a, const GlobalOptions& /*global*/) {
     fmt::print("  {}: {:.4f} .. {:.4f} mm\n", motion::axis_letter(t.axes[i]), *lo, *hi);
   }
   fmt::print("  path length {:.3f} mm; cycle time {:.3f} s at {} mm/s^2 (trapezoidal, rapid F{}); {}\n", path_mm,
-             plan.duration(), limits.accel, limits.rapid_feed_mm_min, plural(program.warnings.size(), "warning"));
+             plan.duration(), limits.accel, limits.rapid_feed_mm_min, counted(program.warnings.size(), "warning"));
   fmt::print("  path control: {}\n", path_control_summary(program));
   return kSuccess;
 }

@@ -63,6 +63,15 @@ std::vector<std::string> axes_to_identify(const IdentifyArgs& a, const std::vect
 }
 
 /// "--shift auto" searches -3..3 samples; a number fixes the shift.
+/// The unit of the positions after --scale: mm for the usual conversions (the --scale help's own
+/// example, 1000 for metres), else the factor (issue 27 §4: "file unit x 1000" for mm).
+std::string scaled_unit(double scale) {
+  if (scale == 1000.0) return "mm (file in m, x 1000)";
+  if (scale == 0.001) return "mm (file in µm, x 0.001)";
+  if (scale == 25.4) return "mm (file in inch, x 25.4)";
+  return fmt::format("file unit x {}", scale);
+}
+
 void apply_shift(const std::string& text, vcnc::IdentificationSettings& settings) {
   if (text == "auto") {
     settings.shift_search = vcnc::ShiftSearch{};
@@ -88,8 +97,11 @@ int run(const IdentifyArgs& a, const GlobalOptions& global) {
   const CaptureSelection selection{a.program.path.empty() ? a.axes : std::vector<std::string>{}, false};
   const std::vector<vcnc::NamedCapture> captures = read_captures(a.captures, a.reading, selection);
   const std::vector<vcnc::NamedCapture> validation = read_captures(a.validate, a.reading, selection);
-  progress(global, "read {} capture(s){} in {:.1f} ms", captures.size(),
-           validation.empty() ? "" : fmt::format(" and {} validation capture(s)", validation.size()), elapsed_ms(start));
+  progress(global, "read {} {}{} in {:.1f} ms", captures.size(), plural(captures.size(), "capture", "captures"),
+           validation.empty() ? ""
+                              : fmt::format(" and {} validation {}", validation.size(),
+                                            plural(validation.size(), "capture", "captures")),
+           elapsed_ms(start));
   if (!a.program.path.empty()) {
     // The identification run checked against its program: units, path, feed override.
     const motion::Program program = load_program(a.program);
@@ -114,7 +126,7 @@ int run(const IdentifyArgs& a, const GlobalOptions& global) {
   const io::TraceProfile profile = capture_profile(a.reading);
   const std::string length_unit = profile.reading.scale == 1.0 ? "as in the file"
                                   : !profile.units.empty()     ? "mm (file in " + profile.units + ")"
-                                                               : fmt::format("file unit x {}", profile.reading.scale);
+                                                               : scaled_unit(profile.reading.scale);
   const auto report_file = open_report(a.report, global);
   std::vector<vcnc::AxisIdentification> records;
   records.reserve(axes.size());
@@ -139,7 +151,7 @@ int run(const IdentifyArgs& a, const GlobalOptions& global) {
       progress(global, "wrote {}", out->path());
     }
   }
-  progress(global, "identified {} axis(es) in {:.1f} ms", axes.size(), elapsed_ms(start));
+  progress(global, "identified {} {} in {:.1f} ms", axes.size(), plural(axes.size(), "axis", "axes"), elapsed_ms(start));
   if (report_file) write_report(report::identification_report(records, captures, validation), *report_file, global);
   return kSuccess;
 }

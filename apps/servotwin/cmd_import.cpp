@@ -26,7 +26,7 @@ struct ImportArgs {
 void summarize(const core::Capture& c, const std::string& source, io::TraceFormat format) {
   fmt::print("{}: {} ({}), {} samples at ts = {} s ({:.3f} s from t = {}), {} {}, lengths in mm\n", source,
              io::trace_format_name(format), format == io::TraceFormat::Csv ? "header row" : "LinuxCNC", c.size(), c.ts,
-             static_cast<double>(c.size() - 1) * c.ts, c.t0, c.axes.size(), c.axes.size() == 1 ? "axis" : "axes");
+             static_cast<double>(c.size() - 1) * c.ts, c.t0, c.axes.size(), plural(c.axes.size(), "axis", "axes"));
   for (const auto& axis : c.axes) {
     const auto [lo, hi] = std::minmax_element(axis.cmd.begin(), axis.cmd.end());
     const vcnc::TrackingStats s = vcnc::tracking_stats(axis);

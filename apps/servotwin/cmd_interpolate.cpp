@@ -20,7 +20,14 @@ int run(const InterpolateArgs& a, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   const auto [limits, home] = resolve_interpolation(a.interpolation);
   const motion::Program program = load_program(a.program, home);
-  const motion::Trajectory trajectory = motion::interpolate(program, limits, parse_axes(a.axes, "--axes"));
+  const std::vector<motion::Axis> axes = parse_axes(a.axes, "--axes");
+  motion::Trajectory trajectory;
+  try {
+    trajectory = motion::interpolate(program, limits, axes);
+  } catch (const core::InputError& e) {
+    rethrow_interpolation_error(e, a.interpolation);
+    throw;
+  }
 
   auto out = open_output(a.output, global);
   io::write_trajectory_csv(out->stream(), trajectory);

@@ -46,7 +46,14 @@ std::pair<vcnc::Prediction, std::optional<vcnc::MeasuredComparison>> predict_pro
   vcnc::PredictionOptions options;
   options.contour_window_s = a.window_s;
   options.workers = threads;
-  vcnc::Prediction prediction = vcnc::predict(program, a.program.path, interpolation.limits, models, options);
+  vcnc::Prediction prediction;
+  try {
+    prediction = vcnc::predict(program, a.program.path, interpolation.limits, models, options);
+  } catch (const core::InputError& e) {
+    // The sample period is the models' (vcnc::predict).
+    rethrow_interpolation_error(e, a.interpolation, {models.front().source, 0, 0, "ts"});
+    throw;
+  }
   std::optional<vcnc::MeasuredComparison> comparison;
   if (!a.capture.empty()) {
     const std::vector<vcnc::NamedCapture> captures = read_captures({a.capture}, a.reading);
@@ -98,7 +105,8 @@ int run(const PredictArgs& a, const GlobalOptions& global) {
   const std::vector<vcnc::AxisModelSpec> models = load_models(a.models);
   auto [prediction, comparison] =
       a.command.empty() ? predict_program(a, models, global.threads) : predict_command(a, models, global.threads);
-  progress(global, "predicted {} axis(es) over {} samples in {:.1f} ms", prediction.axes.size(), prediction.size(),
+  progress(global, "predicted {} {} over {} samples in {:.1f} ms", prediction.axes.size(),
+           plural(prediction.axes.size(), "axis", "axes"), prediction.size(),
            elapsed_ms(start));
   print_prediction_summary(prediction);
   if (comparison) print_comparison(*comparison, prediction.ts, !a.command.empty());

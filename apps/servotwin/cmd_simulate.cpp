@@ -101,10 +101,11 @@ vcnc::DriveSimulation simulate(const machine::PlantConfig& plant, const std::str
   try {
     return vcnc::simulate_drive(plant, controller, settings);
   } catch (const core::InputError& e) {
+    rethrow_as_option(e, {{"amplitude", "--amplitude"},
+                          {"duration_s", "--duration"},
+                          {"torque_limit", "--torque-limit"},
+                          {"settling_band", "--band"}});
     const std::string& field = e.where().field;
-    for (const auto& [name, option] : {std::pair{"amplitude", "--amplitude"}, std::pair{"duration_s", "--duration"},
-                                       std::pair{"torque_limit", "--torque-limit"}, std::pair{"settling_band", "--band"}})
-      if (field == name) throw core::InputError(core::at_field(option), e.reason());
     const bool controller_field = field.rfind("controller.", 0) == 0;
     throw core::InputError({controller_field ? controller_source : plant_source, 0, 0, field}, e.reason());
   }
@@ -164,13 +165,13 @@ vcnc::FrameSequence run_frame(const machine::FlexibleFrame& frame, const tuning:
   try {
     return vcnc::simulate_frame_sequence(frame, tuning::controller_state_space(controller), s);
   } catch (const core::InputError& e) {
-    const std::string& field = e.where().field;
-    for (const auto& [name, option] :
-         {std::pair{"setpoint", "--amplitude"}, std::pair{"load_force", "--load-force"},
-          std::pair{"stator_force", "--stator-force"}, std::pair{"duration", "--duration"},
-          std::pair{"residual_window", "--duration"}, std::pair{"controller", "--controller"}})
-      if (field == name) throw core::InputError(core::at_field(option), e.reason());
-    if (field.rfind("shaper", 0) == 0) throw core::InputError(core::at_field("--shaper"), e.reason());
+    rethrow_as_option(e, {{"setpoint", "--amplitude"},
+                          {"load_force", "--load-force"},
+                          {"stator_force", "--stator-force"},
+                          {"duration", "--duration"},
+                          {"residual_window", "--duration"},
+                          {"controller", "--controller"}});
+    if (e.where().field.rfind("shaper", 0) == 0) throw core::InputError(core::at_field("--shaper"), e.reason());
     throw;
   } catch (const std::domain_error& e) {
     throw core::InputError(core::at_field("--controller"), e.what());

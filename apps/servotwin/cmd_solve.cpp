@@ -36,7 +36,8 @@ int run(const SolveArgs& a, const GlobalOptions& global) {
     out->commit();
     progress(global, "wrote {}", a.output);
   }
-  progress(global, "solved {} sample(s) of statistics in {:.1f} ms", stats.problem.samples(), elapsed_ms(start));
+  progress(global, "solved {} {} of statistics in {:.1f} ms", stats.problem.samples(),
+           plural(stats.problem.samples(), "sample", "samples"), elapsed_ms(start));
   return kSuccess;
 }
 

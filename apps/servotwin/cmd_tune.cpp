@@ -207,7 +207,8 @@ void print_summary(const tuning::TuneResult& r, const std::string& source) {
   fmt::print("{}: antiresonance {:.4g} Hz, resonance ratio r = {:.4g}, zeta_z = {:.3g}, zeta_p = {:.3g}, "
              "rigid pole a = {:.3g} omega_z, Im = {:.5g}{}\n",
              source, hz, p.r, p.zeta_z, p.zeta_p, p.a, p.motor_inertia,
-             p.higher_modes.empty() ? "" : fmt::format(", {} higher mode(s)", p.higher_modes.size()));
+             p.higher_modes.empty() ? "" : fmt::format(", {} higher {}", p.higher_modes.size(),
+                                                                    plural(p.higher_modes.size(), "mode", "modes")));
   if (c.full_order && c.full_order->hinf) {
     print_hinf(c.structure, *c.full_order, c.plant);
   } else if (c.full_order) {

@@ -186,6 +186,12 @@ void refuse_shared_file(const std::string& path, const std::string& option, cons
 
 }  // namespace
 
+void rethrow_as_option(const core::InputError& e, std::initializer_list<OptionName> names) {
+  if (!e.where().file.empty()) return;
+  for (const auto& [parameter, option] : names)
+    if (e.where().field == parameter) throw core::InputError(core::at_field(std::string(option)), e.reason());
+}
+
 std::shared_ptr<io::OutputFile> open_output(const std::string& path, const GlobalOptions& global, const std::string& option) {
   const bool device = io::output_kind(path) == io::OutputKind::kDevice;
   const FileIdentity id = identify(path);

@@ -6,14 +6,17 @@
 #include <cctype>
 #include <fmt/core.h>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <numbers>
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
+#include "servotwin/core/error.hpp"
 #include "servotwin/io/output_file.hpp"
 #include "servotwin/motion/program.hpp"
 
@@ -104,6 +107,13 @@ CLI::Validator choice_of(const std::map<std::string, T>& choices) {
       names);
 }
 
+/// A library parameter and the option the user typed for it, e.g. {"duration_s", "--duration"}.
+using OptionName = std::pair<std::string_view, std::string_view>;
+/// The library names its parameters (`ts`, `max_samples`); the user typed options (issue 27 §4).
+/// Throws `e` again under the option when it names one of `names`' parameters and no file; returns
+/// otherwise, for the caller to name a file or rethrow.
+void rethrow_as_option(const core::InputError& e, std::initializer_list<OptionName> names);
+
 /// Throws core::InputError naming `option` unless ts is a finite sample period > 0 s.
 void check_sample_period(double ts, const std::string& option = "--ts");
 
@@ -163,6 +173,9 @@ void add_old_spelling(CLI::App& command, const std::string& old_name, T& target,
 
 /// Adds the "Examples:" footer shown by --help.
 void set_examples(CLI::App& command, const std::string& examples);
+
+/// `one` for a count of 1, else `many` ("1 axis", "2 axes"; issue 27 §4: "2 axises").
+inline const char* plural(std::size_t count, const char* one, const char* many) { return count == 1 ? one : many; }
 
 /// Milliseconds elapsed since `start` (steady clock, for progress messages).
 double elapsed_ms(std::chrono::steady_clock::time_point start);

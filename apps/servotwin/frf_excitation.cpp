@@ -39,14 +39,16 @@ frf::ExcitationType excitation_type_of(const std::string& name) {
 
 /// The library names its fields; the user typed options.
 [[noreturn]] void rethrow_excitation_error(const core::InputError& e) {
-  static const std::map<std::string, std::string> options{
-      {"f_begin_hz", "--range-hz"}, {"f_end_hz", "--range-hz"},   {"ts", "--ts"},
-      {"duration_s", "--duration"}, {"amplitude", "--amplitude"}, {"periods", "--periods"},
-      {"steps", "--steps"},         {"lines_per_decade", "--lines-per-decade"},
-      {"settle_fraction", "--settle-fraction"}};
-  const auto it = options.find(e.where().field);
-  if (it == options.end()) throw e;
-  throw core::InputError(core::at_field(it->second), e.reason());
+  rethrow_as_option(e, {{"f_begin_hz", "--range-hz"},
+                        {"f_end_hz", "--range-hz"},
+                        {"ts", "--ts"},
+                        {"duration_s", "--duration"},
+                        {"amplitude", "--amplitude"},
+                        {"periods", "--periods"},
+                        {"steps", "--steps"},
+                        {"lines_per_decade", "--lines-per-decade"},
+                        {"settle_fraction", "--settle-fraction"}});
+  throw e;
 }
 
 frf::ExcitationRequest request_of(const ExcitationArgs& a) {
@@ -81,7 +83,7 @@ void print_design(const frf::Excitation& e) {
       break;
     }
     case frf::ExcitationType::kChirp:
-      fmt::print("chirp: {} logarithmic sweep(s) of {} s, {} ... {} Hz\n", e.periods,
+      fmt::print("chirp: {} logarithmic {} of {} s, {} ... {} Hz\n", e.periods, plural(e.periods, "sweep", "sweeps"),
                  static_cast<double>(e.period_samples) * e.ts, e.f_begin_hz, e.f_end_hz);
       fmt::print("  peak {}, rms {:.4g}, crest factor {:.3f}\n", e.amplitude, rms, e.crest_factor);
       break;

@@ -34,4 +34,31 @@ ResolvedInterpolation resolve_interpolation(const InterpolationInput& a) {
   return r;
 }
 
+void rethrow_interpolation_error(const core::InputError& e, const InterpolationInput& a,
+                                 const core::SourceLocation& ts_source) {
+  if (!e.where().file.empty()) return;
+  const std::string& field = e.where().field;
+  struct Limit {
+    const char* field;
+    const CLI::Option* option;
+    const char* name;
+  };
+  // The sample budget is exceeded by a program too long for its sample period: name the period.
+  const Limit limits[] = {{"ts", a.ts_opt, "--ts"},
+                          {"max_samples", a.ts_opt, "--ts"},
+                          {"accel", a.accel_opt, "--accel"},
+                          {"jerk", a.jerk_opt, "--jerk"},
+                          {"rapid_feed_mm_min", a.rapid_opt, "--rapid-feed"},
+                          {"max_feed_mm_min", a.max_feed_opt, "--max-feed"},
+                          {"corner_angle_deg", a.corner_opt, "--corner-angle"}};
+  for (const Limit& l : limits) {
+    if (field != l.field) continue;
+    const bool typed = l.option != nullptr && l.option->count() > 0;
+    const bool is_ts = field == "ts" || field == "max_samples";
+    if (typed) throw core::InputError(core::at_field(l.name), e.reason());
+    if (!a.machine.empty()) throw core::InputError({a.machine, 0, 0, is_ts ? "ts" : "cnc." + field}, e.reason());
+    throw core::InputError(is_ts ? ts_source : core::at_field(l.name), e.reason());
+  }
+}
+
 }  // namespace servotwin::cli

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <string_view>
 
 #include "command.hpp"
 #include "servotwin/core/error.hpp"
@@ -24,6 +25,19 @@ std::string unknown_subcommand(CLI::App& app, int argc, char** argv) {
     return word;
   }
   return {};
+}
+
+/// An error message on stderr with its control bytes escaped (issue 27 §4): a message quotes what
+/// the user gave, and a carriage return or an escape sequence from a file must not rewrite the
+/// terminal. Line breaks and tabs of the message itself, and UTF-8 such as "µm", stay.
+void print_error(const char* kind, const char* message) {
+  std::string shown;
+  for (const char* c = message; *c != '\0'; ++c) {
+    const auto byte = static_cast<unsigned char>(*c);
+    if ((byte < 0x20 && byte != '\n' && byte != '\t') || byte == 0x7f) shown += servotwin::core::printable(std::string_view(c, 1));
+    else shown += *c;
+  }
+  std::fprintf(stderr, "servotwin: %s: %s\n", kind, shown.c_str());
 }
 
 }  // namespace
@@ -58,7 +72,7 @@ int main(int argc, char** argv) {
     std::string names;
     for (const CLI::App* sub : app.get_subcommands({})) names += (names.empty() ? "" : ", ") + sub->get_name();
     std::fprintf(stderr, "servotwin: error: unknown subcommand '%s' (commands: %s; see servotwin --help)\n",
-                 unknown.c_str(), names.c_str());
+                 servotwin::core::printable(unknown).c_str(), names.c_str());
     return kUsageError;
   }
   try {
@@ -84,19 +98,19 @@ int main(int argc, char** argv) {
     return status;
   } catch (const CLI::ParseError& e) {
     discard_outputs();
-    std::fprintf(stderr, "servotwin: error: %s\n", e.what());
+    print_error("error", e.what());
     return kUsageError;
   } catch (const servotwin::core::IoError& e) {
     discard_outputs();
-    std::fprintf(stderr, "servotwin: error: %s\n", e.what());
+    print_error("error", e.what());
     return kIoError;
   } catch (const servotwin::core::InputError& e) {
     discard_outputs();
-    std::fprintf(stderr, "servotwin: error: %s\n", e.what());
+    print_error("error", e.what());
     return kBadInput;
   } catch (const std::exception& e) {
     discard_outputs();
-    std::fprintf(stderr, "servotwin: internal error: %s\n", e.what());
+    print_error("internal error", e.what());
     return kInternalError;
   }
 }

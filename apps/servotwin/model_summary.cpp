@@ -2,7 +2,9 @@
 
 #include "command.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <fmt/core.h>
 #include <numbers>
 
@@ -79,9 +81,17 @@ void print_model_summary(const vcnc::AxisIdentification& r) {
   fmt::print("  {}; {}\n", model.is_stable() ? "stable" : "UNSTABLE", bandwidth_text(model));
   if (!r.shift_trials.empty()) {
     fmt::print("  command shift {} samples, chosen by fit from:", r.regressors.command_shift);
-    for (const auto& t : r.shift_trials)
+    double best = std::numeric_limits<double>::infinity(), chosen = best;
+    for (const auto& t : r.shift_trials) {
       fmt::print(" {}:{}{:.4f}{}", t.shift, t.complete ? "" : ">", t.nrmse, t.stable ? "" : "(unstable)");
+      best = std::min(best, t.nrmse);
+      if (t.shift == r.regressors.command_shift) chosen = t.nrmse;
+    }
     fmt::print("\n");
+    // Issue 27 §4: a choice that is not the lowest nrmse needs its rule stated.
+    if (chosen > best)
+      fmt::print("  (the rule: of the stable models, the smallest |shift| whose nrmse is within {:g} % of the best)\n",
+                 100.0 * vcnc::kShiftFitTolerance);
   } else if (r.regressors.command_shift != 0) {
     fmt::print("  command shift {} samples\n", r.regressors.command_shift);
   }

@@ -214,7 +214,8 @@ Design design_convolve(const MultimodeArgs& a, const std::vector<ModeHz>& modes_
 std::string summary(const Design& d, const std::vector<ModeHz>& modes, const std::vector<BoundRatio>& bounds,
                     const nlohmann::json& residuals) {
   const shaping::Shaper& s = d.shaper;
-  std::string text = fmt::format("{} shaper for {} mode(s): {} impulses, duration {:.6g} s\n", s.type, modes.size(),
+  std::string text = fmt::format("{} shaper for {} {}: {} impulses, duration {:.6g} s\n", s.type, modes.size(),
+                                 plural(modes.size(), "mode", "modes"),
                                  s.times.size(), s.duration());
   text += d.grid_text;
   text += "  t [s]            A\n";

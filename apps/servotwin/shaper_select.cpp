@@ -119,7 +119,8 @@ int run_select(const SelectArgs& a, const GlobalOptions& global) {
     o.scv = a.scv;
     o.freq_uncertainty = a.freq_uncertainty;
     sel = shaping::select_shaper_from_model(modes, o);
-    what = fmt::format("Shapers for the {} fitted mode(s) of {} (damping known):", modes.size(), a.input);
+    what = fmt::format("Shapers for the {} fitted {} of {} (damping known):", modes.size(),
+                       plural(modes.size(), "mode", "modes"), a.input);
   } else {
     shaping::Spectrum spectrum = io::load_klipper_csv(a.input);
     shaping::SpectrumSelectionOptions o;

@@ -1,5 +1,6 @@
 #include "servotwin/core/error.hpp"
 
+#include <algorithm>
 #include <utility>
 
 namespace servotwin::core {
@@ -8,6 +9,24 @@ SourceLocation at_field(std::string field) {
   SourceLocation where;
   where.field = std::move(field);
   return where;
+}
+
+std::string printable(std::string_view text, std::size_t max_chars) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  const std::size_t n = std::min(text.size(), max_chars);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto byte = static_cast<unsigned char>(text[i]);
+    if (byte >= 0x20 && byte < 0x7f) {
+      out += static_cast<char>(byte);
+    } else {
+      out += "\\x";
+      out += kHex[byte >> 4U];
+      out += kHex[byte & 0xFU];
+    }
+  }
+  if (text.size() > max_chars) out += "...";
+  return out;
 }
 
 // Built with append() rather than operator+ chains: GCC 12 reports a false -Wrestrict on the

@@ -10,6 +10,8 @@
 #include <optional>
 #include <ostream>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "csv_lines.hpp"
 #include "servotwin/core/large_buffer.hpp"
@@ -178,20 +180,76 @@ void fit_capacity(std::vector<double>& column, std::size_t rows) {
   }
 }
 
+/// The typical step of the time column: the median of its first steps (a gap further on does not
+/// move it).
+double typical_step(const detail::TimeStamps& t) {
+  constexpr std::size_t kSteps = 1025;
+  std::vector<double> steps;
+  steps.reserve(std::min(t.size() - 1, kSteps));
+  double previous = 0.0;
+  t.for_each([&](std::size_t k, double tk) {
+    if (k > 0 && steps.size() < kSteps) steps.push_back(tk - previous);
+    previous = tk;
+  });
+  const auto middle = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);
+  std::nth_element(steps.begin(), middle, steps.end());
+  return *middle;
+}
+
+/// The first step at least half a step from the typical one (a gap, or a clock that restarted or
+/// stalled), if there is one; a jittered sample is not one.
+std::optional<std::size_t> first_irregular_step(const detail::TimeStamps& t, double step) {
+  std::optional<std::size_t> found;
+  double previous = 0.0;
+  const double tolerance = 0.5 * step;  // a jitter of a sample is not a gap
+  t.for_each([&](std::size_t k, double tk) {
+    if (!found && k > 0 && std::abs(tk - previous - step) > tolerance) found = k;
+    previous = tk;
+  });
+  return found;
+}
+
+/// A sample off the uniform grid. A gap puts the first sample off the end-to-end grid well before
+/// the gap (line 3 of a file whose gap was at line 700, issue 27 §4), so the message names the step
+/// that breaks the grid when there is one, else the first sample off it (a drifting clock).
+[[noreturn]] void throw_off_grid(const detail::TimeStamps& t, const RowLines& lines, double max_jitter,
+                                 std::string_view source, const std::string& column, std::size_t k_off, double t_off,
+                                 double deviation, double period) {
+  const double step = typical_step(t);
+  if (step > 0.0) {
+    if (const auto k = first_irregular_step(t, step)) {
+      double before = 0.0, at = 0.0;
+      t.for_each([&](std::size_t i, double ti) {
+        if (i + 1 == *k) before = ti;
+        if (i == *k) at = ti;
+      });
+      throw core::InputError({std::string(source), lines.line_of(*k), 0, column},
+                             fmt::format("time jumps from {} to {} s here, {:.4g} steps of the trace's typical {:.6g} s: "
+                                         "the trace has a gap or its clock restarted (record it again, or cut the "
+                                         "file at this line)",
+                                         before, at, (at - before) / step, step));
+    }
+  }
+  throw core::InputError({std::string(source), lines.line_of(k_off), 0, column},
+                         fmt::format("time {} is {:.3g} % of the sample period ({} s) off the uniform grid; at "
+                                     "most {:.3g} % jitter is accepted (resample the file first)",
+                                     t_off, 100.0 * deviation / period, period, 100.0 * max_jitter));
+}
+
 void check_time_grid(const detail::TimeStamps& t, const RowLines& lines, double max_jitter, std::string_view source,
                      const std::string& column, double& t0, double& ts) {
   const std::size_t n = t.size();
   t0 = t.front();
   ts = (t.back() - t.front()) / static_cast<double>(n - 1);
   const double origin = t0, period = ts;
+  std::optional<std::pair<std::size_t, double>> off;
   t.for_each([&](std::size_t k, double tk) {
-    const double deviation = std::abs(tk - (origin + static_cast<double>(k) * period));
-    if (deviation > max_jitter * period)
-      throw core::InputError({std::string(source), lines.line_of(k), 0, column},
-                             fmt::format("time {} is {:.3g} % of the sample period ({} s) off the uniform grid; at "
-                                         "most {:.3g} % jitter is accepted (resample the file first)",
-                                         tk, 100.0 * deviation / period, period, 100.0 * max_jitter));
+    if (!off && std::abs(tk - (origin + static_cast<double>(k) * period)) > max_jitter * period) off = {k, tk};
   });
+  if (off) {
+    const double deviation = std::abs(off->second - (origin + static_cast<double>(off->first) * period));
+    throw_off_grid(t, lines, max_jitter, source, column, off->first, off->second, deviation, period);
+  }
 }
 
 void validate_options(const CaptureReadOptions& options, std::string_view source) {

@@ -19,17 +19,20 @@ std::string_view trim(std::string_view s, std::size_t& offset) noexcept {
   return s.substr(b, e - b);
 }
 
-std::string printable(std::string_view text) {
-  constexpr std::size_t kMaxShown = 40;
-  std::string out;
-  for (char c : text.substr(0, kMaxShown)) {
-    const auto u = static_cast<unsigned char>(c);
-    out += (u >= 0x20 && u < 0x7f) ? c : '?';
-  }
-  if (text.size() > kMaxShown) out += "...";
-  return out;
-}
+std::string printable(std::string_view text) { return core::printable(text); }
 }  // namespace
+
+void check_header_delimiter(const std::vector<Field>& header, char delimiter, const core::SourceLocation& where,
+                            std::string_view option) {
+  if (header.size() != 1) return;
+  for (const char other : {';', '\t', '|'}) {
+    if (other == delimiter || header.front().text.find(other) == std::string_view::npos) continue;
+    const std::string shown = other == '\t' ? "tab" : std::string("'") + other + "'";
+    const std::string remedy = option.empty() ? "save it comma-separated" : "read it with " + std::string(option) + " " + shown;
+    throw core::InputError(where, "the header is a single column '" + printable(header.front().text) + "': the file looks " +
+                                      shown + "-separated (" + remedy + ")");
+  }
+}
 
 void split_csv_line(std::string_view line, std::vector<Field>& fields, char delimiter) {
   fields.clear();

@@ -22,6 +22,13 @@ struct Field {
 /// one pair of double quotes are removed from each field.
 void split_csv_line(std::string_view line, std::vector<Field>& fields, char delimiter = ',');
 
+/// A header split into one column that holds another common delimiter (';', tab, '|') is a file
+/// with that delimiter (European spreadsheets write ';'): core::InputError at the header saying
+/// so, and how to read it: with `option` (the reader's delimiter setting as the user gives it) or,
+/// when empty, saved comma-separated. Returns otherwise.
+void check_header_delimiter(const std::vector<Field>& header, char delimiter, const core::SourceLocation& where,
+                            std::string_view option);
+
 /// Splits `line` at runs of blanks (spaces, tabs) into `fields`; leading and trailing blanks
 /// make no empty fields (halsampler ends every value with a blank).
 void split_blank_separated(std::string_view line, std::vector<Field>& fields);

@@ -183,6 +183,11 @@ core::FrequencyResponse read_frf_csv(std::istream& in, std::string_view source_n
     } else {
       p.value = {detail::parse_number(fields[c.re], where, "re"), detail::parse_number(fields[c.im], where, "im")};
     }
+    // A magnitude beyond a double (mag_db 1e12, or re and im near 1e308) could not be written back.
+    if (!std::isfinite(std::abs(p.value)))
+      throw core::InputError({source, line_number, 0, c.polar ? "mag_db" : "re"},
+                             c.polar ? "the magnitude overflows a double: mag_db must be below 6165 dB"
+                                     : "the magnitude |re + j im| overflows a double");
     p.quality = optional_field(fields, c.quality, where, c.quality_name);
     p.snr = optional_field(fields, c.snr, where, "snr");
     p.amplitude = optional_field(fields, c.amplitude, where, "amplitude");

@@ -130,6 +130,7 @@ SignalTable read_signal_csv(std::istream& in, std::string_view source_name, cons
   line_number = detail::read_header_line(in, source, line, "a header row with column names");
   const std::size_t header_line = line_number;
   detail::split_csv_line(line, fields);
+  detail::check_header_delimiter(fields, ',', {source, header_line, 0, ""}, "");
 
   SignalTable table;
   table.source = source;

@@ -42,6 +42,8 @@ TraceTable::TraceTable(std::istream& in, const std::string& source, const Captur
     }
     header_line_ = line_number_;
     split_csv_line(line_, raw_, delimiter_);
+    if (options.format == TraceFormat::Csv)
+      check_header_delimiter(raw_, delimiter_, {source, header_line_, 0, ""}, "--delimiter");
     // The names must outlive the line buffer: keep a copy.
     names_.reserve(raw_.size());
     for (const Field& f : raw_) names_.emplace_back(f.text);

@@ -59,24 +59,6 @@ std::size_t reserve_hint(std::string_view text) noexcept {
   return std::min(lines, text.size() / 3 + 1);
 }
 
-std::string printable(std::string_view text, std::size_t max_chars) {
-  static constexpr char kHex[] = "0123456789abcdef";
-  std::string out;
-  const std::size_t n = std::min(text.size(), max_chars);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto byte = static_cast<unsigned char>(text[i]);
-    if (byte >= 0x20 && byte < 0x7f) {
-      out += static_cast<char>(byte);
-    } else {
-      out += "\\x";
-      out += kHex[byte >> 4U];
-      out += kHex[byte & 0xFU];
-    }
-  }
-  if (text.size() > max_chars) out += "...";
-  return out;
-}
-
 std::string format_number(double value) {
   std::array<char, 400> buf{};
   // Plain decimals for people unless the magnitude calls for an exponent.

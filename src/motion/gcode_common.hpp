@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "servotwin/core/error.hpp"
 #include "servotwin/motion/gcode.hpp"
 #include "servotwin/motion/program.hpp"
 
@@ -65,8 +66,8 @@ class LineSplitter {
 /// ("M3\n") could hold, so blank-line padding cannot make a reader over-allocate.
 std::size_t reserve_hint(std::string_view text) noexcept;
 
-/// Text of a word for messages: printable ASCII kept, other bytes as \xHH, cut after max_chars.
-std::string printable(std::string_view text, std::size_t max_chars = 24);
+/// Text of a word for messages (core::printable), cut after a word's usual length.
+inline std::string printable(std::string_view text, std::size_t max_chars = 24) { return core::printable(text, max_chars); }
 /// Shortest round-trip decimal text of a number, for messages.
 std::string format_number(double value);
 /// A computed value (radius, tolerance) for a message: 6 significant digits.

@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "gcode_common.hpp"
 #include "interpolation_detail.hpp"
 #include "servotwin/core/error.hpp"
 
@@ -13,7 +14,7 @@ namespace servotwin::motion {
 namespace {
 
 [[noreturn]] void bad_limit(const char* field, const std::string& expected, double value) {
-  throw core::InputError(core::SourceLocation{"", 0, 0, field}, "must be " + expected + ", got " + std::to_string(value));
+  throw core::InputError(core::SourceLocation{"", 0, 0, field}, "must be " + expected + ", got " + detail::format_number(value));
 }
 
 void require_positive(const char* field, double value) {

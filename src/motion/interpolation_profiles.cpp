@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "gcode_common.hpp"
 #include "interpolation_detail.hpp"
 #include "servotwin/core/error.hpp"
 
@@ -147,7 +148,7 @@ std::size_t checked_samples(double duration, double ts, std::size_t so_far, std:
   if (!(count <= static_cast<double>(max_samples)) || so_far + static_cast<std::size_t>(count) > max_samples)
     throw core::InputError(core::SourceLocation{"", 0, 0, "max_samples"},
                            "the program would need more than " + std::to_string(max_samples) +
-                               " samples at ts = " + std::to_string(ts) + " s");
+                               " samples at ts = " + format_number(ts) + " s");
   return std::max<std::size_t>(1, static_cast<std::size_t>(count));
 }
 

@@ -102,9 +102,6 @@ double captures_quantum(const std::vector<NamedCapture>& captures, const std::st
   return common;
 }
 
-/// Relative margin within which a shift's fit counts as good as the best one (choose_shift).
-constexpr double kShiftFitTolerance = 0.02;
-
 /// The solver's model with the shift in settings.regressors, without its simulated fit.
 AxisIdentification solve_with_shift(const std::vector<NamedCapture>& captures, const std::string& axis,
                                     const IdentificationSettings& settings, const rapid::Bounds& bounds) {

@@ -94,7 +94,7 @@ TEST_F(FrfExcitation, ChirpAndSineStepsReadBack) {
   auto r = run("frf excitation --type chirp --range-hz 2:200 --ts 0.001 --duration 9 --periods 3 --amplitude 1 "
                "-o chirp.csv");
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_THAT(r.out, HasSubstr("chirp: 3 logarithmic sweep(s) of 3 s, 2 ... 200 Hz"));
+  EXPECT_THAT(r.out, HasSubstr("chirp: 3 logarithmic sweeps of 3 s, 2 ... 200 Hz"));
   play("chirp.csv", "rec_chirp.csv", 50, 0.001);
   r = run("frf estimate rec_chirp.csv --input iq --response speed --excitation chirp.csv -o chirp_frf.csv");
   ASSERT_EQ(r.status, 0) << r.err;

@@ -99,7 +99,7 @@ TEST_F(Hardening, ManyCloseModesGiveAShaperOrBadInput) {
   for (int i = 0; i < 40; ++i) modes += " --mode-hz " + std::to_string(0.1 + 0.1 * i) + ":0.05";
   const Result r = run("shaper multimode" + modes + " --ts 0.01 -o s.json");
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_THAT(r.out, HasSubstr("lp shaper for 40 mode(s)"));
+  EXPECT_THAT(r.out, HasSubstr("lp shaper for 40 modes"));
   EXPECT_TRUE(fs::exists(path("s.json")));
 }
 

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace servotwin::core {
 
@@ -21,6 +22,10 @@ struct SourceLocation {
 /// A location that is a field alone (a parameter, option or JSON member), for errors in values
 /// given through the API rather than read from a file.
 SourceLocation at_field(std::string field);
+
+/// Text from the user quoted in a message: printable ASCII kept, every other byte as \xHH (a control
+/// byte in a file must not reach the terminal), cut after `max_chars` with "...".
+std::string printable(std::string_view text, std::size_t max_chars = 40);
 
 /// Formats a location as `file:line:column` followed by ` (field)` when a field is set.
 std::string to_string(const SourceLocation& where);
