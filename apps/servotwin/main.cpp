@@ -7,6 +7,7 @@
 
 #include "command.hpp"
 #include "servotwin/core/error.hpp"
+#include "servotwin/version.hpp"
 
 namespace {
 
@@ -49,7 +50,7 @@ int main(int argc, char** argv) {
                "servotwin"};
   app.require_subcommand(1);
   app.fallthrough();  // global flags (-q, -f) may follow the subcommand
-  app.set_version_flag("--version", "servotwin 0.1.0");
+  app.set_version_flag("--version", std::string("servotwin ") + servotwin::kVersion);
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "No progress messages on stderr");
   app.add_flag("-f,--force", global.force, "Overwrite existing output files");

@@ -5,6 +5,7 @@
 #include <servotwin/machine/presets.hpp>
 #include <servotwin/motion/identification_program.hpp>
 #include <servotwin/motion/interpolation.hpp>
+#include <servotwin/version.hpp>
 
 int main() {
   using namespace servotwin;
@@ -12,6 +13,7 @@ int main() {
   const auto loop = machine::equivalent_closed_loop(machine.axes.front(), machine.ts);
   const auto program = motion::make_identification_program(motion::identification_defaults(motion::IdentificationSet::Standard));
   const auto trajectory = motion::interpolate(program, motion::InterpolationLimits{});
-  std::printf("closed-loop a2 = %.2f, identification program: %zu samples\n", loop.coefficients.a2, trajectory.size());
+  std::printf("servotwin %s: closed-loop a2 = %.2f, identification program: %zu samples\n", kVersion, loop.coefficients.a2,
+              trajectory.size());
   return trajectory.size() > 0 ? 0 : 1;
 }

@@ -14,6 +14,7 @@ run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/build -G ${GENERATOR}
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build -j 2)
 run(${WORK_DIR}/build/consumer)
 message(STATUS "consumer printed: ${last_output}")
-if(NOT last_output MATCHES "closed-loop a2 = 44356.23")
+# The version comes from the installed servotwin/version.hpp, generated from project().
+if(NOT last_output MATCHES "^servotwin ${VERSION}: closed-loop a2 = 44356.23")
   message(FATAL_ERROR "unexpected consumer output: ${last_output}")
 endif()

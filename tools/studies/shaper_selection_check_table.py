@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Checks that a study document is current: every non-empty line a study program prints must
-appear verbatim in the document. Usage: check_table.py PROGRAM DATA_DIR DOCUMENT"""
+appear verbatim in the document. Usage: shaper_selection_check_table.py PROGRAM DATA_DIR DOCUMENT"""
 import subprocess
 import sys
 
