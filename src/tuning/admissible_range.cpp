@@ -1,4 +1,4 @@
-// Admissible bandwidth range of a PI (catalog C7.3, C7.6; plan §1.3) and the C7.4 damping limit.
+// Admissible bandwidth range of a PI (catalog C7.3, C7.6) and the C7.4 damping limit.
 #include <algorithm>
 #include <cmath>
 #include <limits>

@@ -1,5 +1,5 @@
 // Indices of a PI/PID velocity loop and the J1/J2 choice of ω* (loop_analysis.hpp; catalog C7.8,
-// C7.15; issue-7 plan §1.6, §1.14).
+// C7.15).
 #include "servotwin/tuning/loop_analysis.hpp"
 
 #include <algorithm>

@@ -292,7 +292,7 @@ NormalizedPlant normalized_two_mass(double r, double zeta_z, std::optional<doubl
   return p;
 }
 
-// ---------------------------------------------------------------- two-mass realization (plan §1.1)
+// ---------------------------------------------------------------- two-mass realization
 
 bool FrictionTwoMass::passive() const noexcept {
   return damping >= 0.0 && motor_viscous >= 0.0 && load_viscous >= 0.0;

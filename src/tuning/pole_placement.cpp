@@ -1,4 +1,4 @@
-// Numeric partial pole placement (catalog C7.3 "numerical equivalent", plan §1.3) and the second
+// Numeric partial pole placement (catalog C7.3 "numerical equivalent") and the second
 // pair by exact division.
 #include <Eigen/Dense>
 #include <algorithm>

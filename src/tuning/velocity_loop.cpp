@@ -65,7 +65,8 @@ ControllerTf pid_controller(const PidGains& g) {
 std::optional<TwoMassTransfer> two_mass_transfer(const NormalizedPlant& plant) {
   const std::optional<FrictionTwoMass> m = two_mass_realization(plant);
   if (!m) return std::nullopt;
-  // Every function over the monic (s + a)(s² + 2ζp r s + r²) = D'/Il (plan §1.1 realization).
+  // Every function over the monic (s + a)(s² + 2ζp r s + r²) = D'/Il (the two-mass realization,
+  // normalized_plant.hpp).
   const TransferFunction motor = plant.motor(false);
   const Polynomial& den = motor.den();
   const double k = m->stiffness;

@@ -1,5 +1,5 @@
 // Admissible bandwidth range, the C7.4 limit tables and design rules, and PID by virtual inertia
-// (catalog C7.3–C7.6; issue-7 plan §1.3–§1.5, §2 rows E25-a, C7.4 table, E26, E-PID, A5).
+// (catalog C7.3–C7.6; examples E25-a, the C7.4 table, E26, E-PID, A5).
 // "Printed" values are the dissertation's as restated in the catalog (C7.4 tables to the 3
 // printed digits, E25-a to 4); "fixture" values come from tools/reference/tuning_reference.py
 // (dense grid of numpy.roots-based tests + 80 bisection steps, an independent implementation).
@@ -53,7 +53,7 @@ void expect_range(const AdmissibleRange& range, const nlohmann::json& f, double 
 }
 
 TEST(Limits, C74TablesPrintedAndFixture) {
-  // C7.4 [D] printed to 3 digits (plan §2): ξ2max for ξ* = √2/2 and 1 (rows up to r = 2.5 resp. √5)
+  // C7.4 [D] printed to 3 digits: ξ2max for ξ* = √2/2 and 1 (rows up to r = 2.5 resp. √5)
   // and ω*max for every r.
   const double r_values[10] = {1.2, 1.5, std::sqrt(3.0), 2.0, std::sqrt(5.0), 2.5, 3.0, 4.0, 5.0, 8.0};
   const double xi2_printed[2][10] = {{0.168, 0.449, 0.707, 1.061, 1.414, 1.856, kNotPrinted, kNotPrinted, kNotPrinted, kNotPrinted},
@@ -87,7 +87,7 @@ TEST(Limits, C74TablesPrintedAndFixture) {
 }
 
 TEST(Limits, E26PlantRangeIsBelowThePrintedOmegaStar) {
-  // E26 extra (plan §2): at ω* = 0.67 the second pair has a real root at −0.6654 — slower than the
+  // E26 extra: at ω* = 0.67 the second pair has a real root at −0.6654 — slower than the
   // assigned pair — so the admissible range ends just below 0.67 (fixture: 0.668477).
   const NormalizedPlant plant = normalized_two_mass(3.0, 0.01);
   const nlohmann::json& f = reference().at("e26").at("admissible");
@@ -171,7 +171,7 @@ TEST(Limits, A5BeltAxis) {
 }
 
 TEST(Pid, EPidVirtualInertiaIdealDerivative) {
-  // E-PID [R] (plan §2): r = 4, r̄ = 2, ξ* = √2/2, ω* = 0.5, ideal D ⇒ Kd = 4, Kp = 13.518218,
+  // E-PID [R]: r = 4, r̄ = 2, ξ* = √2/2, ω* = 0.5, ideal D ⇒ Kd = 4, Kp = 13.518218,
   // Ki = 3.897059; closed-loop poles = E25-c's (−0.35355 ± 0.35355j, −0.99827 ± 1.45640j).
   const NormalizedPlant plant = normalized_two_mass(4.0, 0.0);
   const PidDesign d = pid_design(plant, 2.0, 0.5, kSqrtHalf, 0.0);
@@ -202,7 +202,7 @@ TEST(Pid, EPidVirtualInertiaIdealDerivative) {
 
 TEST(Pid, EPidWithDerivativeFilter) {
   // τ = 0.01: the pair is placed with the filter included (fixture: numpy placement on the 5th-order
-  // loop), and the ideal-derivative gains with the filter added keep the poles within 3 % (plan §2).
+  // loop), and the ideal-derivative gains with the filter added keep the poles within 3 %.
   const NormalizedPlant plant = normalized_two_mass(4.0, 0.0);
   const PidDesign d = pid_design(plant, 2.0, 0.5, kSqrtHalf, 0.01);
   const nlohmann::json& f = reference().at("e_pid");

@@ -4,7 +4,7 @@
 //     block-diagram frequency functions (numpy, delay exact) on a 200 001-point grid refined by
 //     scipy.optimize.minimize_scalar / brentq; time responses by scipy.signal.lsim of the rational
 //     closed loop (scipy.interpolate.pade delay) on 400 001 points over 60 time constants;
-//   * the printed minimum closed-loop dampings of plan §2 row E24-qual ([R]);
+//   * the printed minimum closed-loop dampings of E24 (its qualitative row, [R]);
 //   * closed forms of a PI loop on a rigid 1/s plant (a two-mass plant with r = 1, whose zeros
 //     cancel its resonance exactly);
 //   * a brute-force ω* scan for choose_omega_star().
@@ -316,7 +316,7 @@ TEST(LoopAnalysis, ChooseOmegaStarAgreesWithBruteForce) {
 }
 
 TEST(LoopAnalysis, ChooseOmegaStarPidReproducedByAnalyse) {
-  // E-PID plant (plan §2: r = 4, Kd = 4 for r̄ = 2) with ζz = 0.01 and the filter τ = 0.01: the
+  // E-PID plant (r = 4, Kd = 4 for r̄ = 2) with ζz = 0.01 and the filter τ = 0.01: the
   // wp shortcut of the J1 search (ωl/ω* scaled by R_wp/R_1, valid for w_d = 0) must agree with a
   // loop built with that wp, and J2 with analyse() of the returned ω*.
   const NormalizedPlant plant = normalized_two_mass(4.0, 0.01);

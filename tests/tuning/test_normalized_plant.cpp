@@ -1,5 +1,5 @@
 // Normalization of fitted plant models and the two-mass realization with friction (catalog §0,
-// C7.2, C7.6, C7.16; issue-7 plan §1.1). Expected values: the catalog's E24 demo plant (printed
+// C7.2, C7.6, C7.16). Expected values: the catalog's E24 demo plant (printed
 // Im = 1, Il = 8, b = 0.2, k = 8 and [V] ωz = 1, ξz = 0.0125, ωn = 3, ξ = 0.0375); the plan's
 // E-fric row ([R]: f = 8.06307520, bl = 0.89378451, b = 0.07378451, bm = 0.90621549); the
 // table-5.1 preset's physical realization (include/servotwin/machine/flexible_presets.hpp, derived
@@ -101,7 +101,7 @@ TEST(Normalize, MeasuredResponseReconstructsTheFittedModel) {
     ASSERT_EQ(p.higher_modes.size(), 2u);
     EXPECT_DOUBLE_EQ(p.higher_modes[0].antiresonance.omega_rad_s, 280.0 / 80.0);  // sorted by resonance
     EXPECT_DOUBLE_EQ(p.higher_modes[1].resonance.omega_rad_s, 1040.0 / 80.0);
-    // Im = 1/(K Π(ωzi/ωi)² g_lag), g_lag = 1/p (plan §1.1).
+    // Im = 1/(K Π(ωzi/ωi)² g_lag), g_lag = 1/p.
     const double k_design = 350.0 * std::pow(280.0 / 600.0, 2) * std::pow(820.0 / 1040.0, 2) / 3000.0;
     EXPECT_LT(rel_diff(p.motor_inertia, 1.0 / k_design), 1e-15);
     ASSERT_TRUE(p.hf.delay_s && p.hf.lag_pole_rad_s && p.hf.current_lag_s && p.hf.feedback_filter_s);

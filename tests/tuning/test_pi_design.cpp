@@ -1,4 +1,4 @@
-// PI design by partial pole placement (catalog C7.1, C7.3; issue-7 plan §1.3, §2). Where each
+// PI design by partial pole placement (catalog C7.1, C7.3). Where each
 // expected value comes from is said per test: "printed" = the dissertation via the catalog,
 // "[D]/[R]" = derived by the catalog or the plan from printed formulas, "fixture" =
 // tests/data/tuning/tuning_reference.json from tools/reference/tuning_reference.py (numpy
@@ -58,7 +58,7 @@ TEST(RigidTuning, E24RigidPolePlacementDerivedAndNumeric) {
 }
 
 TEST(RigidTuning, E24LoopsOnTheTwoMassPlantWithFeedbackFilter) {
-  // E24-qual [R] (plan §2): minimum closed-loop damping with the τf = 0.01 measurement filter:
+  // E24-qual [R]: minimum closed-loop damping with the τf = 0.01 measurement filter:
   // SO 0.0125 (a pair at the antiresonance, −0.012 ± 1.000j), ω* = 0.3 → 0.745, 0.6 → 0.487,
   // 2 → 0.060; the fixture (numpy.roots) to 1e-9.
   HfDynamics filter;
@@ -212,7 +212,7 @@ TEST(PolePlacement, AssignedPairIsARootAndIsContinuousAcrossCriticalDamping) {
 }
 
 TEST(PolePlacement, E28FrictionPlantGainsDerived) {
-  // E28 (plan §2, [D][R]): K = 1, a = 0.1, ξ = 0.02, ξz = 0.01, ω = 2, ωz = 1, ω* = 0.9:
+  // E28 ([D][R]): K = 1, a = 0.1, ξ = 0.02, ξz = 0.01, ω = 2, ωz = 1, ω* = 0.9:
   // ξ* = √2/2 → Kp = 3.429190, Ki = 1.248403, poles −0.63640 ± 0.63640j, −1.16820 ± 0.42018j;
   // ξ* = 1 → Kp = 3.294913, Ki = 1.061761.
   const NormalizedPlant plant = normalized_two_mass(2.0, 0.01, 0.02, 0.1);

@@ -1,4 +1,4 @@
-// P position loop over a velocity loop (catalog C7.10, plan §1.8). Expected values: eq. 7.110 (closed
+// P position loop over a velocity loop (catalog C7.10). Expected values: eq. 7.110 (closed
 // form, derivation in position_loop.hpp) against the TF algebra, roots for the Routh verdicts,
 // brute-force sampling of Δ for the exact worst case, and tests/data/tuning/robust_reference.json
 // (tools/reference/tuning_robust_reference.py: dense grid + brentq in scipy) for E27-Kpp. The printed

@@ -1,4 +1,4 @@
-// Interval-parameter robustness of the PI velocity loop (catalog C7.9, E28; plan §1.7).
+// Interval-parameter robustness of the PI velocity loop (catalog C7.9, E28).
 // References: tests/data/tuning/tuning_reference.json "robustness", written by
 // tools/reference/tuning_reference.py (closed loop expanded with numpy.polymul, stability from
 // numpy.roots / batched companion eigenvalues, design by the c(s1) evaluation); the catalog's E28

@@ -1,4 +1,4 @@
-// Multiplicative uncertainty (catalog C7.9, plan §1.7): the W2 envelope fit, RS/NP/RP of a velocity
+// Multiplicative uncertainty (catalog C7.9): the W2 envelope fit, RS/NP/RP of a velocity
 // loop and the largest ω* passing them. Expected values: closed forms written out here, exactness on
 // synthetic residuals of a known W2, brute-force searches in the tests, the catalog's E27 number
 // (0.68 printed, 0.681 recomputed) and tests/data/tuning/robust_reference.json written by

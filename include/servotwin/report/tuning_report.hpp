@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The report of a controller tuning (`servotwin tune --report`, issue-7 plan §3.3): the plant as
+/// The report of a controller tuning (`servotwin tune --report`): the plant as
 /// the tuner normalized it, the design (ω*, gains, the automatic ω* scan, closed-loop poles), the
 /// loop shapes and margins, the robustness tests against an uncertainty weight W2, the P position
 /// loop of a pi+p design, and the linear step responses of the rational closed loop.

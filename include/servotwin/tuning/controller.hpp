@@ -2,7 +2,7 @@
 /// \file
 /// The tuned controller as the library hands it to users (and io::controller_json writes it):
 /// physical and normalized gains, the 2-DoF controller as a continuous and a discretized state
-/// space, the design parameters and the predicted indices (issue-7 plan §3.2 controller.hpp).
+/// space, the design parameters and the predicted indices.
 ///
 /// The cascade structures of chapter 7 (C7.3–C7.5, C7.10):
 ///   pi    u = (wp kp + ki/s) ω* − (kp + ki/s) ωm

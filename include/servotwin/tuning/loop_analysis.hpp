@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Indices of a PI/PID velocity loop (catalog C7.8, C7.15; issue-7 plan §1.6, §1.14): bandwidths,
+/// Indices of a PI/PID velocity loop (catalog C7.8, C7.15): bandwidths,
 /// sensitivity peaks, gain/phase/modulus margins, the load-disturbance index J2, step overshoot and
 /// settling, the ITAE of a load-torque step, the controller's high-frequency gain, and the choice
 /// of ω* from J1/J2. All quantities in normalized units (time scaled by ωz).

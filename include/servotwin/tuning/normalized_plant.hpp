@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// The normalized flexible plant that every chapter-7 design works on (seed catalog §0, C7.2,
-/// C7.6, C7.16; issue-7 plan §1.1).
+/// C7.6, C7.16).
 ///
 /// Time is scaled by the first antiresonance ωz (normalized s = s_phys/ωz) and torque by Im·ωz,
 /// so that the motor-side design plant reads
@@ -25,7 +25,7 @@
 
 namespace servotwin::tuning {
 
-/// Known high-frequency dynamics of the loop ("designed without, evaluated with", plan §1.7):
+/// Known high-frequency dynamics of the loop ("designed without, evaluated with"):
 /// current (torque) loop lag, velocity-measurement filter, pure delay and a unit-DC-gain lag
 /// p/(s + p) (the fitted model's lag, catalog A6). Absent members contribute 1.
 /// Units are seconds and rad/s, or normalized time inside a NormalizedPlant.
@@ -77,8 +77,8 @@ struct NormalizedPlant {
 
   /// Motor velocity per motor torque ωm/Tm in normalized units. Without higher modes this is the
   /// design model Pm above. With them, each higher mode enters as the unit-DC-gain factor
-  /// (ωi²/ωzi²)(s² + 2ζzi ωzi s + ωzi²)/(s² + 2ζi ωi s + ωi²): their DC gain is already in Im
-  /// (plan §1.1), so both agree at low frequency. HF dynamics are never included.
+  /// (ωi²/ωzi²)(s² + 2ζzi ωzi s + ωzi²)/(s² + 2ζi ωi s + ωi²): their DC gain is already in Im,
+  /// so both agree at low frequency. HF dynamics are never included.
   [[nodiscard]] core::TransferFunction motor(bool with_higher_modes = true) const;
   /// Load velocity per motor torque ωl/Tm of the two-mass realization (with viscous friction when
   /// a > 0 or ζp ≠ r ζz): (b s + k)/(k (s + a)(s² + 2ζp r s + r²)), from two_mass_realization()
@@ -115,7 +115,7 @@ struct NormalizedPlant {
 /// as NormalizedPlant::motor(true) multiplies it in (numerator and denominator as they enter).
 [[nodiscard]] core::TransferFunction mode_factor(const fit::Mode& mode);
 
-/// Normalizes a fitted plant model (plan §1.1). The first mode (lowest resonance) gives ωz, r,
+/// Normalizes a fitted plant model. The first mode (lowest resonance) gives ωz, r,
 /// ζz, ζp; the modes are sorted by resonance frequency. Im = 1/(K·Π_{i≥2}(ωzi/ωi)²·g_lag), where
 /// g_lag = 1/p is the DC gain of the model's lag 1/(s + p): the lag itself moves into `hf` as
 /// p/(s + p), and the model's delay too (added to `hf.delay_s`). `hf` holds further known
@@ -153,7 +153,7 @@ struct PhysicalTwoMass {
          load_viscous = 0.0;
 };
 
-/// The two-mass realization of the design model Pm (plan §1.1, replacing the garbled eqs.
+/// The two-mass realization of the design model Pm (replacing the garbled eqs.
 /// 7.73–7.74): k = Il = f, α = (a(r²−1) + 2ζz − 2ζp r)/2, bl = α + ζz f, b = 2ζz f − bl,
 /// bm = a r² − bl, with f the positive root of (1−ζz²) f² + (1 − r² + 2aζz r² − 2aζp r − 2αζz) f − α² = 0
 /// (the product of the roots is <= 0, so one root is >= 0). b, bl, bm within ±1e-10·(1 + f) of 0

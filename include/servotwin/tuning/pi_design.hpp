@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// PI and PID velocity-loop design for flexible drives by partial pole placement (seed catalog
-/// C7.1–C7.7; issue-7 plan §1.2–§1.5).
+/// C7.1–C7.7).
 ///
 /// Control law (2DoF, catalog C7.2): Tm = Kp(w_p ω* − ωm) + (Ki/s)(ω* − ωm) + (Kd s/(τ s + 1))(w_d ω* − ωm).
 /// The weights w_p, w_d shape the reference response only; the closed-loop poles are the roots of
@@ -75,7 +75,7 @@ struct PolePlacement {
 };
 
 /// Numeric partial pole placement for any plant ωm/Tm = N/Dp (catalog C7.3 "numerical
-/// equivalent", plan §1.3): (Kp, Ki) such that s² + 2ζ*ω* s + ω*² divides c(s), with Kd and τ
+/// equivalent"): (Kp, Ki) such that s² + 2ζ*ω* s + ω*² divides c(s), with Kd and τ
 /// given (0, 0 for a PI). The two real conditions are the coefficients of the remainder of
 /// c(s) modulo the pair, computed on the frequency axis scaled by ω* (so the rows are O(1)); for
 /// ζ* < 1 they are equivalent to Re/Im of c(s1) = 0, for ζ* = 1 to c(−ω*) = c′(−ω*) = 0, and
@@ -140,8 +140,8 @@ struct AdmissibleRange {
 /// (normalized). Method: a log grid of 96 points over [1e-3, 1] (lower end a/100 when the rigid
 /// pole is smaller), each point a numeric pole placement + Routh test + second pair, then 60
 /// bisection steps on each boundary. For an exactly frictionless plant (a = 0, ζp = r ζz to 1e-12)
-/// the positive-gain limit comes from frictionless_gain_limit() on the virtual plant of `kd`
-/// (plan §1.3). An admissible window narrower than the grid spacing (~7 %) can be missed. Empty
+/// the positive-gain limit comes from frictionless_gain_limit() on the virtual plant of `kd`.
+/// An admissible window narrower than the grid spacing (~7 %) can be missed. Empty
 /// (omega_max = 0) when no grid point is admissible; `upper` then names the first point's failure.
 [[nodiscard]] AdmissibleRange admissible_range(const NormalizedPlant& plant, double zeta_star, double kd = 0.0);
 
@@ -186,7 +186,7 @@ struct ResonanceRatioAdvice {
 /// InputError unless r > 1 and r_target > 1.
 [[nodiscard]] double virtual_inertia_kd(double r, double r_target);
 
-/// The smallest derivative filter bandwidth allowed by plan §1.5: 1/τ = max(r, 5 ω*) (normalized:
+/// The smallest derivative filter bandwidth we allow: 1/τ = max(r, 5 ω*) (normalized:
 /// above the resonance and five times the assigned bandwidth). Noise may call for less.
 [[nodiscard]] double default_derivative_time_constant(double r, double omega_star);
 

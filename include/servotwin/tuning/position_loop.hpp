@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// A P position loop over a closed velocity loop (seed catalog C7.10, issue-7 plan §1.8). The
+/// A P position loop over a closed velocity loop (seed catalog C7.10). The
 /// position controller ω* = Kpp (φ* − φm) feeds the velocity reference of any velocity loop given by
 /// its closed-loop functions (a PI/PID VelocityLoop here; an LQG or H∞ loop later):
 ///

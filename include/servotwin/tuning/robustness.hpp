@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Parametric robustness of a PI velocity loop (seed catalog C7.9, issue-7 plan §1.7): Kharitonov's
+/// Parametric robustness of a PI velocity loop (seed catalog C7.9): Kharitonov's
 /// four polynomials, exhaustive gridding of the parameter box, and the largest bandwidth ω* whose
 /// nominal design is robustly stable.
 ///

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The one-call tuner that `servotwin tune` runs (issue-7 plan §3.2 tune.hpp): from a fitted plant
+/// The one-call tuner that `servotwin tune` runs: from a fitted plant
 /// model to a checked cascade controller.
 ///
 /// Pipeline: normalize the model (known HF dynamics set aside: designed without, evaluated with),
@@ -56,7 +56,7 @@ struct TuneOptions {
   /// largest bandwidth over r̄ from 2 toward r (a lag or delay can leave no phase for the
   /// derivative gain that r̄ = 2 needs on a high-r plant).
   std::optional<double> target_r = 2.0;
-  std::optional<double> tau;            ///< PID derivative filter [s]; default plan §1.5
+  std::optional<double> tau;            ///< PID derivative filter [s]; default: default_derivative_time_constant
   bool allow_negative_kd = false;       ///< PID with r < r̄ (acceleration feedback)
   double ms = 1.5;                      ///< ‖S‖∞ limit
   double mt = 1.5;                      ///< tracking peak limit

@@ -1,9 +1,9 @@
 #pragma once
 /// \file
-/// Unstructured multiplicative uncertainty of the velocity-loop plant (seed catalog C7.9, issue-7
-/// plan §1.7): P = Pn(1 + Δ W2) with ‖Δ‖∞ < 1, the weight W2 estimated from identification
-/// residuals, and the robust-stability / nominal-performance / robust-performance tests of a PI/PID
-/// velocity loop together with the largest bandwidth ω* that passes them.
+/// Unstructured multiplicative uncertainty of the velocity-loop plant (seed catalog C7.9):
+/// P = Pn(1 + Δ W2) with ‖Δ‖∞ < 1, the weight W2 estimated from identification residuals, and
+/// the robust-stability / nominal-performance / robust-performance tests of a PI/PID velocity loop
+/// together with the largest bandwidth ω* that passes them.
 ///
 ///   RS: ‖W2 T‖∞ < 1,   NP: ‖W1 S‖∞ < 1 with W1 = 1/M_S,   RP: sup_ω (|W1 S| + |W2 T|) < 1.
 ///

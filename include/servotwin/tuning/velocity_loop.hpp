@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// The closed velocity loop of a cascade PI/PID drive on a normalized flexible plant (catalog C7.2,
-/// C7.5, C7.8; issue-7 plan §1.2, §1.6, §1.14): every transfer function the indices, the
+/// C7.5, C7.8): every transfer function the indices, the
 /// robustness tests and the position loop need, both as exact frequency functions (the delay of
 /// the known HF dynamics evaluated as e^{−jωT}) and as rational transfer functions for time
 /// simulation and stability tests (the delay replaced by a Padé approximant).
