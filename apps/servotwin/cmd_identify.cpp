@@ -62,7 +62,6 @@ std::vector<std::string> axes_to_identify(const IdentifyArgs& a, const std::vect
   return names;
 }
 
-/// "--shift auto" searches -3..3 samples; a number fixes the shift.
 /// The unit of the positions after --scale: mm for the usual conversions (the --scale help's own
 /// example, 1000 for metres), else the factor (issue 27 §4: "file unit x 1000" for mm).
 std::string scaled_unit(double scale) {
@@ -72,6 +71,7 @@ std::string scaled_unit(double scale) {
   return fmt::format("file unit x {}", scale);
 }
 
+/// "--shift auto" searches -3..3 samples; a number fixes the shift.
 void apply_shift(const std::string& text, vcnc::IdentificationSettings& settings) {
   if (text == "auto") {
     settings.shift_search = vcnc::ShiftSearch{};

@@ -51,7 +51,8 @@ std::pair<vcnc::Prediction, std::optional<vcnc::MeasuredComparison>> predict_pro
     prediction = vcnc::predict(program, a.program.path, interpolation.limits, models, options);
   } catch (const core::InputError& e) {
     // The sample period is the models' (vcnc::predict).
-    rethrow_interpolation_error(e, a.interpolation, {models.front().source, 0, 0, "ts"});
+    const core::SourceLocation models_ts{models.front().source, 0, 0, "ts"};
+    rethrow_interpolation_error(e, a.interpolation, &models_ts);
     throw;
   }
   std::optional<vcnc::MeasuredComparison> comparison;

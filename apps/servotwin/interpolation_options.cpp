@@ -35,7 +35,7 @@ ResolvedInterpolation resolve_interpolation(const InterpolationInput& a) {
 }
 
 void rethrow_interpolation_error(const core::InputError& e, const InterpolationInput& a,
-                                 const core::SourceLocation& ts_source) {
+                                 const core::SourceLocation* ts_source) {
   if (!e.where().file.empty()) return;
   const std::string& field = e.where().field;
   struct Limit {
@@ -55,9 +55,10 @@ void rethrow_interpolation_error(const core::InputError& e, const InterpolationI
     if (field != l.field) continue;
     const bool typed = l.option != nullptr && l.option->count() > 0;
     const bool is_ts = field == "ts" || field == "max_samples";
+    if (is_ts && ts_source != nullptr) throw core::InputError(*ts_source, e.reason());
     if (typed) throw core::InputError(core::at_field(l.name), e.reason());
     if (!a.machine.empty()) throw core::InputError({a.machine, 0, 0, is_ts ? "ts" : "cnc." + field}, e.reason());
-    throw core::InputError(is_ts ? ts_source : core::at_field(l.name), e.reason());
+    throw core::InputError(core::at_field(l.name), e.reason());
   }
 }
 

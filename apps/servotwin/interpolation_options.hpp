@@ -30,10 +30,10 @@ struct ResolvedInterpolation {
 ResolvedInterpolation resolve_interpolation(const InterpolationInput& input);
 
 /// The interpolator's errors name its limits (`accel`, `corner_angle_deg`, `max_samples`): throws
-/// `e` again naming the option or the machine file each came from (issue 27 §4); `ts_source` is
-/// where the sample period came from when not from --ts or the machine (predict: the model file).
-/// Returns when `e` is about something else.
+/// `e` again naming the option or the machine file each came from (issue 27 §4). `ts_source`, when
+/// given, is where the sample period came from instead of --ts or the machine (predict: the models
+/// set it). Returns when `e` is about something else.
 void rethrow_interpolation_error(const core::InputError& e, const InterpolationInput& input,
-                                 const core::SourceLocation& ts_source = core::at_field("--ts"));
+                                 const core::SourceLocation* ts_source = nullptr);
 
 }  // namespace servotwin::cli

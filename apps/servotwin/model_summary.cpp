@@ -82,7 +82,9 @@ void print_model_summary(const vcnc::AxisIdentification& r) {
   if (!r.shift_trials.empty()) {
     fmt::print("  command shift {} samples, chosen by fit from:", r.regressors.command_shift);
     double best = std::numeric_limits<double>::infinity(), chosen = best;
+    bool any_stable = false;
     for (const auto& t : r.shift_trials) {
+      any_stable = any_stable || t.stable;
       fmt::print(" {}:{}{:.4f}{}", t.shift, t.complete ? "" : ">", t.nrmse, t.stable ? "" : "(unstable)");
       best = std::min(best, t.nrmse);
       if (t.shift == r.regressors.command_shift) chosen = t.nrmse;
@@ -90,8 +92,8 @@ void print_model_summary(const vcnc::AxisIdentification& r) {
     fmt::print("\n");
     // Issue 27 §4: a choice that is not the lowest nrmse needs its rule stated.
     if (chosen > best)
-      fmt::print("  (the rule: of the stable models, the smallest |shift| whose nrmse is within {:g} % of the best)\n",
-                 100.0 * vcnc::kShiftFitTolerance);
+      fmt::print("  (the rule: {}the smallest |shift| whose nrmse is within {:g} % of the best)\n",
+                 any_stable ? "of the stable models, " : "", 100.0 * vcnc::kShiftFitTolerance);
   } else if (r.regressors.command_shift != 0) {
     fmt::print("  command shift {} samples\n", r.regressors.command_shift);
   }

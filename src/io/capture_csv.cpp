@@ -191,7 +191,8 @@ double typical_step(const detail::TimeStamps& t) {
     if (k > 0 && steps.size() < kSteps) steps.push_back(tk - previous);
     previous = tk;
   });
-  const auto middle = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);
+  // The lower median: of two steps (three rows), the smaller is the one a gap did not widen.
+  const auto middle = steps.begin() + static_cast<std::ptrdiff_t>((steps.size() - 1) / 2);
   std::nth_element(steps.begin(), middle, steps.end());
   return *middle;
 }

@@ -25,7 +25,7 @@ std::string printable(std::string_view text) { return core::printable(text); }
 void check_header_delimiter(const std::vector<Field>& header, char delimiter, const core::SourceLocation& where,
                             std::string_view option) {
   if (header.size() != 1) return;
-  for (const char other : {';', '\t', '|'}) {
+  for (const char other : {',', ';', '\t', '|'}) {
     if (other == delimiter || header.front().text.find(other) == std::string_view::npos) continue;
     const std::string shown = other == '\t' ? "tab" : std::string("'") + other + "'";
     const std::string remedy = option.empty() ? "save it comma-separated" : "read it with " + std::string(option) + " " + shown;

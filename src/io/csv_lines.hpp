@@ -22,8 +22,8 @@ struct Field {
 /// one pair of double quotes are removed from each field.
 void split_csv_line(std::string_view line, std::vector<Field>& fields, char delimiter = ',');
 
-/// A header split into one column that holds another common delimiter (';', tab, '|') is a file
-/// with that delimiter (European spreadsheets write ';'): core::InputError at the header saying
+/// A header split into one column that holds another common delimiter (',', ';', tab, '|') is a
+/// file with that delimiter (European spreadsheets write ';'): core::InputError at the header saying
 /// so, and how to read it: with `option` (the reader's delimiter setting as the user gives it) or,
 /// when empty, saved comma-separated. Returns otherwise.
 void check_header_delimiter(const std::vector<Field>& header, char delimiter, const core::SourceLocation& where,

@@ -179,7 +179,8 @@ core::FrequencyResponse read_frf_csv(std::istream& in, std::string_view source_n
     if (c.polar) {
       const double mag_db = detail::parse_number(fields[c.mag_db], where, "mag_db");
       const double phase_deg = detail::parse_number(fields[c.phase_deg], where, "phase_deg");
-      p.value = std::polar(std::pow(10.0, mag_db / 20.0), phase_deg * std::numbers::pi / 180.0);
+      // Divided first: phase_deg * π overflows for |phase_deg| above 5.7e307.
+      p.value = std::polar(std::pow(10.0, mag_db / 20.0), phase_deg / 180.0 * std::numbers::pi);
     } else {
       p.value = {detail::parse_number(fields[c.re], where, "re"), detail::parse_number(fields[c.im], where, "im")};
     }

@@ -108,6 +108,15 @@ TEST(FrfCsv, AcceptsMagnitudeAndPhaseInAnyOrder) {
   EXPECT_EQ(r.points[1].quality, 0.02);
 }
 
+// Issue 27 §5 (fuzzing): a magnitude beyond a double is refused naming mag_db; a phase of 1e308
+// degrees is a phase (it overflowed to infinity when multiplied by π first, then read as NaN).
+TEST(FrfCsv, MagnitudeOverflowIsRefusedAndHugePhasesAreRead) {
+  EXPECT_THAT(error_of("freq_hz,mag_db,phase_deg\n1,7000,0\n").what(), HasSubstr("(mag_db): the magnitude overflows a double"));
+  EXPECT_THAT(error_of("freq_hz,re,im\n1,1.5e308,1.5e308\n2,1,0\n").what(), HasSubstr("|re + j im| overflows"));
+  const auto r = read("freq_hz,mag_db,phase_deg\n1,0,1e308\n2,0,0\n");
+  EXPECT_NEAR(std::abs(r.points[0].value), 1.0, 1e-12);  // |e^{jφ}| = 1 for any finite φ
+}
+
 TEST(FrfCsv, MissingColumnsAreNamed) {
   auto e = error_of("f,re,im\n1,1,0\n2,1,0\n");
   EXPECT_EQ(e.where().line, 1u);

@@ -51,12 +51,12 @@ struct IdentificationSettings {
   std::size_t workers = 0;
 };
 
-/// One shift tried by the search.
 /// How --shift auto chooses among its trials: of the stable models (all trials when none is stable),
 /// the smallest |shift| whose nrmse is within this relative margin of the best (a shift only a
 /// little better in fit is more likely noise than delay).
 inline constexpr double kShiftFitTolerance = 0.02;
 
+/// One shift tried by the search.
 struct ShiftTrial {
   int shift = 0;
   double nrmse = 0.0;  ///< simulated tracking error on the identification captures
